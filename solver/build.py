@@ -1,0 +1,130 @@
+"""Scene -> particle arrays: fluid lattice, wall particles and their mDBC ghost nodes."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .scene import Rect, Scene
+
+FLUID, BOUNDARY = 0, 1
+
+
+@dataclass
+class Particles:
+    """Structure of arrays, all of length N; boundary-only fields are NaN/-1 for fluid."""
+
+    x: np.ndarray
+    z: np.ndarray
+    u: np.ndarray
+    w: np.ndarray
+    rho: np.ndarray
+    kind: np.ndarray  # int8: 0 fluid, 1 boundary
+    wall: np.ndarray  # int32: wall index, -1 for fluid
+    gx: np.ndarray  # ghost node of a boundary particle
+    gz: np.ndarray
+    pid: np.ndarray  # int64: original particle number
+
+    @property
+    def n(self) -> int:
+        return self.x.size
+
+
+def lattice(rect: Rect, dp: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points of the dp lattice inside rect, offset dp/2 from its edges."""
+    nx = int(round((rect.x[1] - rect.x[0]) / dp))
+    nz = int(round((rect.z[1] - rect.z[0]) / dp))
+    xs = rect.x[0] + (np.arange(nx) + 0.5) * dp
+    zs = rect.z[0] + (np.arange(nz) + 0.5) * dp
+    X, Z = np.meshgrid(xs, zs, indexing="ij")
+    return X.ravel(), Z.ravel()
+
+
+def hydrostatic_density(scene: Scene, z: np.ndarray, top: float) -> np.ndarray:
+    """Tait density of a column at rest with free surface at ``top`` (bed-normal gravity)."""
+    rho0, c0 = scene.fluid.density, scene.c0
+    B = c0 * c0 * rho0 / 7.0
+    p = rho0 * (-scene.gravity[1]) * np.maximum(top - z, 0.0)
+    return rho0 * (1.0 + p / B) ** (1.0 / 7.0)
+
+
+def _inside_any(px, pz, walls, periodic):
+    for w in walls:
+        xx = px
+        if periodic is not None:
+            x0, x1 = periodic
+            xx = x0 + np.mod(px - x0, x1 - x0)
+        if w.x[0] < xx < w.x[1] and w.z[0] < pz < w.z[1]:
+            return True
+    return False
+
+
+def ghost_node(px: float, pz: float, walls, periodic, eps: float) -> tuple[float, float]:
+    """Mirror of (px, pz) through the nearest point of the wall/fluid interface.
+
+    Candidates are the projections on every wall edge and every wall corner; a candidate
+    counts when a step beyond it, away from the particle, is outside all walls (so shared
+    edges between touching walls are skipped and inner corners mirror diagonally). Edges on
+    the periodic ends are not interfaces.
+    """
+    best, best_d2 = None, np.inf
+    for w in walls:
+        edges = [((w.x[0], w.z[0]), (w.x[1], w.z[0])), ((w.x[0], w.z[1]), (w.x[1], w.z[1])),
+                 ((w.x[0], w.z[0]), (w.x[0], w.z[1])), ((w.x[1], w.z[0]), (w.x[1], w.z[1]))]
+        for (ax, az), (bx, bz) in edges:
+            if periodic is not None and ax == bx and (abs(ax - periodic[0]) < eps or abs(ax - periodic[1]) < eps):
+                continue
+            ex, ez = bx - ax, bz - az
+            t = ((px - ax) * ex + (pz - az) * ez) / (ex * ex + ez * ez)
+            for tt in (min(max(t, 0.0), 1.0), 0.0, 1.0):
+                cx, cz = ax + tt * ex, az + tt * ez
+                dx, dz = cx - px, cz - pz
+                d2 = dx * dx + dz * dz
+                if d2 >= best_d2 or d2 == 0.0:
+                    continue
+                d = np.sqrt(d2)
+                if _inside_any(cx + eps * dx / d, cz + eps * dz / d, walls, periodic):
+                    continue
+                best, best_d2 = (cx, cz), d2
+    if best is None:
+        return np.nan, np.nan
+    return 2 * best[0] - px, 2 * best[1] - pz
+
+
+def build_particles(scene: Scene) -> Particles:
+    """Fill fluid blocks and walls on the dp lattice; fluid starts hydrostatic if g_z != 0."""
+    dp = scene.dp
+    fx, fz, fu, fw = [], [], [], []
+    for b in scene.fluid.blocks:
+        x, z = lattice(b, dp)
+        fx.append(x), fz.append(z)
+        fu.append(np.full(x.size, b.velocity[0])), fw.append(np.full(x.size, b.velocity[1]))
+    fx, fz = np.concatenate(fx), np.concatenate(fz)
+    fu, fw = np.concatenate(fu), np.concatenate(fw)
+    top = max(b.z[1] for b in scene.fluid.blocks)
+    frho = hydrostatic_density(scene, fz, top)
+
+    bx, bz, bwall = [], [], []
+    for i, w in enumerate(scene.walls):
+        x, z = lattice(w, dp)
+        bx.append(x), bz.append(z), bwall.append(np.full(x.size, i, dtype=np.int32))
+    if bx:
+        bx, bz, bwall = np.concatenate(bx), np.concatenate(bz), np.concatenate(bwall)
+    else:
+        bx, bz, bwall = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int32)
+    gx = np.full(bx.size, np.nan)
+    gz = np.full(bx.size, np.nan)
+    for k in range(bx.size):
+        gx[k], gz[k] = ghost_node(bx[k], bz[k], scene.walls, scene.periodic_x, 1e-6 * dp)
+    brho = np.full(bx.size, scene.fluid.density)
+
+    nf, nb = fx.size, bx.size
+    return Particles(
+        x=np.concatenate([fx, bx]), z=np.concatenate([fz, bz]),
+        u=np.concatenate([fu, np.zeros(nb)]), w=np.concatenate([fw, np.zeros(nb)]),
+        rho=np.concatenate([frho, brho]),
+        kind=np.concatenate([np.full(nf, FLUID, np.int8), np.full(nb, BOUNDARY, np.int8)]),
+        wall=np.concatenate([np.full(nf, -1, np.int32), bwall]),
+        gx=np.concatenate([np.full(nf, np.nan), gx]), gz=np.concatenate([np.full(nf, np.nan), gz]),
+        pid=np.arange(nf + nb, dtype=np.int64),
+    )

@@ -1,0 +1,124 @@
+"""Cell-linked list: cells of side >= 2h, particles kept sorted by cell.
+
+Cell id = ix * ncz + iz. Boundary particles whose 3x3 cell neighbourhood holds no fluid
+go to a sentinel bucket after the last cell: they take part in no pair loop.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+OUTSIDE = -1
+
+
+@dataclass(frozen=True)
+class Grid:
+    x0: float
+    z0: float
+    csx: float
+    csz: float
+    ncx: int
+    ncz: int
+    periodic: bool
+    period: float
+
+    @property
+    def ncells(self) -> int:
+        return self.ncx * self.ncz
+
+    @classmethod
+    def cover(cls, x0, x1, z0, z1, reach, periodic):
+        """Grid over [x0, x1] x [z0, z1] with cells no smaller than ``reach``."""
+        ncx = max(int(math.floor((x1 - x0) / reach)), 1) if periodic else int(math.ceil((x1 - x0) / reach))
+        ncz = max(int(math.ceil((z1 - z0) / reach)), 1)
+        csx = (x1 - x0) / ncx if periodic else reach
+        if periodic and ncx < 3:
+            raise ValueError("periodic grid needs at least 3 cells across the period")
+        return cls(x0, z0, csx, reach, max(ncx, 1), ncz, periodic, (x1 - x0) if periodic else 0.0)
+
+
+@nb.njit(cache=True)
+def assign_cells(x, z, kind, x0, z0, csx, csz, ncx, ncz, cell):
+    """Write each particle's cell (sentinel ncx*ncz for idle boundary particles).
+
+    Returns the index of a fluid particle outside the grid, or -1.
+    """
+    n = x.size
+    ncells = ncx * ncz
+    has_fluid = np.zeros(ncells, dtype=np.bool_)
+    bad = -1
+    for i in range(n):
+        ix = int(math.floor((x[i] - x0) / csx))
+        iz = int(math.floor((z[i] - z0) / csz))
+        if ix < 0 or ix >= ncx or iz < 0 or iz >= ncz or not (math.isfinite(x[i]) and math.isfinite(z[i])):
+            cell[i] = ncells
+            if kind[i] == 0 and bad < 0:
+                bad = i
+            continue
+        c = ix * ncz + iz
+        cell[i] = c
+        if kind[i] == 0:
+            has_fluid[c] = True
+    for i in range(n):
+        if kind[i] == 0 or cell[i] == ncells:
+            continue
+        c = cell[i]
+        ix = c // ncz
+        iz = c - ix * ncz
+        near = False
+        for dx in range(-1, 2):
+            jx = ix + dx
+            if jx < 0:
+                jx += ncx
+            elif jx >= ncx:
+                jx -= ncx
+            for dz in range(-1, 2):
+                jz = iz + dz
+                if jz < 0 or jz >= ncz:
+                    continue
+                if has_fluid[jx * ncz + jz]:
+                    near = True
+        if not near:
+            cell[i] = ncells
+    return bad
+
+
+@nb.njit(cache=True)
+def counting_sort(cell, nbuckets, order, start):
+    """order: particle indices sorted by cell; start[c]..start[c+1] is cell c's range."""
+    start[:] = 0
+    for i in range(cell.size):
+        start[cell[i] + 1] += 1
+    for c in range(nbuckets):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    for i in range(cell.size):
+        c = cell[i]
+        order[fill[c]] = i
+        fill[c] += 1
+
+
+@nb.njit(parallel=True, cache=True)
+def gather(src, order, dst):
+    for i in nb.prange(order.size):
+        dst[i] = src[order[i]]
+
+
+@nb.njit(cache=True)
+def column_split(start, ncx, ncz, nthreads, split):
+    """Columns [split[t], split[t+1]) for thread t, balancing particle counts."""
+    total = start[ncx * ncz]
+    split[0] = 0
+    t = 1
+    for ix in range(ncx):
+        if t >= nthreads:
+            break
+        if start[(ix + 1) * ncz] >= total * t / nthreads:
+            split[t] = ix + 1
+            t += 1
+    while t <= nthreads:
+        split[t] = ncx
+        t += 1

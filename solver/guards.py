@@ -1,0 +1,62 @@
+"""Divergence detectors. Each returns a reason string, or '' when the state is sound."""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+
+@nb.njit(parallel=True, cache=True)
+def fluid_health(x, z, u, w, rho, kind, n, rho0, walls, periodic, px0, period, out):
+    """One pass over fluid particles.
+
+    out[0]: number of non-finite fluid values, out[1]: max |rho/rho0 - 1|,
+    out[2]: max depth of a fluid particle inside a wall rectangle (0 if none),
+    out[3]: kinetic energy per unit mass sum 0.5 |v|^2.
+    """
+    nbad = np.zeros(n)
+    dev = np.zeros(n)
+    pen = np.zeros(n)
+    ke = np.zeros(n)
+    for i in nb.prange(n):
+        if kind[i] != 0:
+            continue
+        if not (math.isfinite(x[i]) and math.isfinite(z[i]) and math.isfinite(u[i])
+                and math.isfinite(w[i]) and math.isfinite(rho[i])):
+            nbad[i] = 1.0
+            continue
+        dev[i] = abs(rho[i] / rho0 - 1.0)
+        ke[i] = 0.5 * (u[i] * u[i] + w[i] * w[i])
+        xi = x[i]
+        if periodic:
+            xi = px0 + (xi - px0) % period
+        for k in range(walls.shape[0]):
+            if walls[k, 0] < xi < walls[k, 1] and walls[k, 2] < z[i] < walls[k, 3]:
+                d = min(xi - walls[k, 0], walls[k, 1] - xi, z[i] - walls[k, 2], walls[k, 3] - z[i])
+                if d > pen[i]:
+                    pen[i] = d
+    out[0] = nbad.sum()
+    out[1] = dev.max() if n > 0 else 0.0
+    out[2] = pen.max() if n > 0 else 0.0
+    out[3] = ke.sum()
+
+
+def check(health, guards, dp: float) -> str:
+    """Reason for divergence from the fluid_health summary, or ''."""
+    if health[0] > 0:
+        return f"non-finite values in {int(health[0])} fluid particles"
+    if health[1] > guards.max_density_deviation:
+        return (f"density deviation max|rho/rho0 - 1| = {health[1]:.3g} exceeds "
+                f"guards.max_density_deviation = {guards.max_density_deviation:g}")
+    if health[2] > guards.penetration * dp:
+        return (f"a fluid particle crossed a wall: {health[2] / dp:.2f} dp inside "
+                f"(guards.penetration = {guards.penetration:g} dp)")
+    return ""
+
+
+def check_dt(dt: float, dt_first: float, guards) -> str:
+    if not math.isfinite(dt) or dt < guards.min_dt_fraction * dt_first:
+        return (f"time step collapsed: dt = {dt:.3g} s below guards.min_dt_fraction = "
+                f"{guards.min_dt_fraction:g} of the first dt ({dt_first:.3g} s)")
+    return ""

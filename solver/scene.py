@@ -1,0 +1,346 @@
+"""Scene: a generic 2D SPH case as plain dataclasses, read from YAML or a dict.
+
+Every value is checked here, before anything is compiled: unknown keys, wrong
+types and impossible values raise :class:`SceneError` naming the key.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any, get_args, get_origin, get_type_hints
+
+import yaml
+
+SHIFTING_METHODS = ("none", "skillen", "lind")
+BOUNDARY_METHODS = ("mdbc", "dbc")
+BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
+
+
+class SceneError(ValueError):
+    """A scene value is missing, of the wrong type or physically impossible."""
+
+
+@dataclass
+class Rect:
+    """Axis-aligned rectangle [x0, x1] x [z0, z1] in metres."""
+
+    x: tuple[float, float]
+    z: tuple[float, float]
+
+    def overlap_area(self, other: "Rect") -> float:
+        dx = min(self.x[1], other.x[1]) - max(self.x[0], other.x[0])
+        dz = min(self.z[1], other.z[1]) - max(self.z[0], other.z[0])
+        return max(dx, 0.0) * max(dz, 0.0)
+
+    @property
+    def area(self) -> float:
+        return (self.x[1] - self.x[0]) * (self.z[1] - self.z[0])
+
+
+@dataclass
+class FluidBlock(Rect):
+    """A fluid rectangle filled on the dp lattice, optionally with an initial velocity."""
+
+    velocity: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass
+class Wall(Rect):
+    """A solid rectangle filled with boundary particles.
+
+    ``velocity`` is the wall velocity seen by the fluid (no-slip target). A wall with
+    ``moving: false`` keeps its particles in place while carrying that velocity (a belt);
+    ``moving: true`` translates them. The velocity ramps linearly from 0 at
+    ``ramp_delay`` to its full value at ``ramp_delay + ramp_time``.
+    """
+
+    name: str = "wall"
+    velocity: tuple[float, float] = (0.0, 0.0)
+    moving: bool = False
+    ramp_time: float = 0.0
+    ramp_delay: float = 0.0
+
+
+@dataclass
+class Fluid:
+    density: float
+    viscosity: float  # dynamic viscosity mu [Pa s]
+    blocks: list[FluidBlock]
+
+
+@dataclass
+class Sound:
+    """c0 directly, or c0 = coefsound * sqrt(|g| depth)."""
+
+    c0: float | None = None
+    coefsound: float | None = None
+    depth: float | None = None
+
+
+@dataclass
+class Shifting:
+    method: str = "none"
+    coefficient: float | None = None  # A (skillen, default 2) or A_L (lind, default 1)
+    surface_threshold: float = 1.5  # div r below this marks the free surface
+    max_shift: float = 0.1  # skillen: clip of each component, in units of dp
+
+
+@dataclass
+class Physics:
+    boundary: str = "mdbc"
+    density_diffusion: float | None = 0.1  # delta; null/false switches it off
+    shifting: Shifting = field(default_factory=Shifting)
+
+
+@dataclass
+class Time:
+    end: float
+    output_interval: float
+    diagnostics_interval: float | None = None  # default: output_interval / 10
+
+
+@dataclass
+class Guards:
+    max_density_deviation: float = 0.1  # max |rho/rho0 - 1|
+    min_dt_fraction: float = 1.0e-3  # dt below this fraction of the first dt = collapse
+    penetration: float = 0.5  # depth inside a wall, in units of dp, that counts as crossing
+
+
+@dataclass
+class Domain(Rect):
+    """Box that fluid particles must stay in; default: walls and fluid plus a margin."""
+
+
+@dataclass
+class Scene:
+    dp: float
+    fluid: Fluid
+    time: Time
+    sound: Sound
+    name: str = "scene"
+    ch: float = 1.5
+    walls: list[Wall] = field(default_factory=list)
+    gravity: tuple[float, float] = (0.0, -9.81)
+    cfl: float = 0.2
+    periodic_x: tuple[float, float] | None = None
+    domain: Domain | None = None
+    physics: Physics = field(default_factory=Physics)
+    guards: Guards = field(default_factory=Guards)
+    memory_budget_gb: float = 4.0
+
+    # ---- derived quantities -------------------------------------------------
+    @property
+    def h(self) -> float:
+        return self.ch * self.dp
+
+    @property
+    def nu(self) -> float:
+        return self.fluid.viscosity / self.fluid.density
+
+    @property
+    def c0(self) -> float:
+        if self.sound.c0 is not None:
+            return self.sound.c0
+        g = math.hypot(*self.gravity)
+        return self.sound.coefsound * math.sqrt(g * self.sound.depth)
+
+    @property
+    def shifting_coefficient(self) -> float:
+        s = self.physics.shifting
+        if s.coefficient is not None:
+            return s.coefficient
+        return 2.0 if s.method == "skillen" else 1.0
+
+    def estimated_particles(self) -> int:
+        cell = self.dp * self.dp
+        n = sum(b.area for b in self.fluid.blocks) + sum(w.area for w in self.walls)
+        return int(round(n / cell))
+
+    def to_dict(self) -> dict:
+        return _plain(dataclasses.asdict(self))
+
+    def to_yaml(self) -> str:
+        return yaml.safe_dump(self.to_dict(), sort_keys=False)
+
+
+# ---- reading and validation -------------------------------------------------
+
+def load_scene(path) -> Scene:
+    """Read a YAML scene file and validate it."""
+    with open(path) as fh:
+        try:
+            data = yaml.safe_load(fh)
+        except yaml.YAMLError as exc:
+            raise SceneError(f"{path}: not valid YAML: {exc}") from None
+    return scene_from_dict(data)
+
+
+def scene_from_dict(data: Any) -> Scene:
+    """Build a Scene from plain data, check types and values; raise SceneError."""
+    scene = _build(Scene, data, "scene")
+    validate(scene)
+    return scene
+
+
+def _plain(obj):
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    return obj
+
+
+def _as_float(value, key):
+    if isinstance(value, bool):
+        raise SceneError(f"{key}: expected a number, got {value!r}")
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, str):  # YAML 1.1 reads 1e-5 as a string
+        try:
+            return float(value)
+        except ValueError:
+            pass
+    raise SceneError(f"{key}: expected a number, got {value!r}")
+
+
+def _build(tp, value, key):
+    origin = get_origin(tp)
+    args = get_args(tp)
+    if origin is None and dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise SceneError(f"{key}: expected a mapping, got {value!r}")
+        hints = get_type_hints(tp)
+        fields = {f.name: f for f in dataclasses.fields(tp)}
+        unknown = sorted(set(value) - set(fields))
+        if unknown:
+            raise SceneError(
+                f"{key}: unknown key(s) {', '.join(map(str, unknown))}; allowed: {', '.join(fields)}")
+        kwargs = {}
+        for name, f in fields.items():
+            if name in value:
+                kwargs[name] = _build(hints[name], value[name], f"{key}.{name}")
+            elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise SceneError(f"{key}.{name}: required key is missing")
+        return tp(**kwargs)
+    if origin is type(None) or tp is type(None):
+        return None
+    if args and type(None) in args:  # Optional[...]
+        if value is None or value is False:
+            return None
+        inner = [a for a in args if a is not type(None)][0]
+        return _build(inner, value, key)
+    if origin is tuple:
+        if not isinstance(value, (list, tuple)) or len(value) != len(args):
+            raise SceneError(f"{key}: expected a list of {len(args)} numbers, got {value!r}")
+        return tuple(_build(a, v, f"{key}[{i}]") for i, (a, v) in enumerate(zip(args, value)))
+    if origin is list:
+        if not isinstance(value, list):
+            raise SceneError(f"{key}: expected a list, got {value!r}")
+        return [_build(args[0], v, f"{key}[{i}]") for i, v in enumerate(value)]
+    if tp is float:
+        return _as_float(value, key)
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise SceneError(f"{key}: expected true or false, got {value!r}")
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise SceneError(f"{key}: expected a string, got {value!r}")
+        return value
+    raise TypeError(f"unsupported scene type {tp} at {key}")  # pragma: no cover
+
+
+def _positive(value, key):
+    if not (value > 0 and math.isfinite(value)):
+        raise SceneError(f"{key}: must be a positive finite number, got {value!r}")
+
+
+def _interval(pair, key):
+    if not pair[1] > pair[0]:
+        raise SceneError(f"{key}: upper bound must exceed lower bound, got {list(pair)}")
+
+
+def validate(scene: Scene) -> None:
+    """Check physical and geometric consistency; raise SceneError naming the key."""
+    _positive(scene.dp, "dp")
+    _positive(scene.ch, "ch")
+    if not 0.5 <= scene.ch <= 4.0:
+        raise SceneError(f"ch: h/dp must lie in [0.5, 4], got {scene.ch}")
+    _positive(scene.cfl, "cfl")
+    _positive(scene.fluid.density, "fluid.density")
+    _positive(scene.fluid.viscosity, "fluid.viscosity")
+    if not scene.fluid.blocks:
+        raise SceneError("fluid.blocks: at least one fluid block is required")
+    s = scene.sound
+    if s.c0 is not None:
+        _positive(s.c0, "sound.c0")
+        if s.coefsound is not None:
+            raise SceneError("sound: give either c0 or coefsound with depth, not both")
+    else:
+        if s.coefsound is None or s.depth is None:
+            raise SceneError("sound: give c0, or coefsound and depth")
+        _positive(s.coefsound, "sound.coefsound")
+        _positive(s.depth, "sound.depth")
+        if math.hypot(*scene.gravity) == 0:
+            raise SceneError("sound.coefsound: needs non-zero gravity; give sound.c0 instead")
+    _positive(scene.time.end, "time.end")
+    _positive(scene.time.output_interval, "time.output_interval")
+    if scene.time.diagnostics_interval is not None:
+        _positive(scene.time.diagnostics_interval, "time.diagnostics_interval")
+    ph = scene.physics
+    if ph.boundary not in BOUNDARY_METHODS:
+        raise SceneError(
+            f"physics.boundary: {ph.boundary!r} is not one of {', '.join(BOUNDARY_METHODS)}")
+    if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
+        raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
+    sh = ph.shifting
+    if sh.method not in SHIFTING_METHODS:
+        raise SceneError(
+            f"physics.shifting.method: {sh.method!r} is not one of {', '.join(SHIFTING_METHODS)}")
+    if sh.coefficient is not None:
+        _positive(sh.coefficient, "physics.shifting.coefficient")
+    _positive(sh.max_shift, "physics.shifting.max_shift")
+    if not 0 < sh.surface_threshold < 2:
+        raise SceneError(
+            f"physics.shifting.surface_threshold: must lie in (0, 2), got {sh.surface_threshold}")
+    g = scene.guards
+    _positive(g.max_density_deviation, "guards.max_density_deviation")
+    _positive(g.min_dt_fraction, "guards.min_dt_fraction")
+    _positive(g.penetration, "guards.penetration")
+    _positive(scene.memory_budget_gb, "memory_budget_gb")
+
+    for i, b in enumerate(scene.fluid.blocks):
+        _interval(b.x, f"fluid.blocks[{i}].x")
+        _interval(b.z, f"fluid.blocks[{i}].z")
+    for i, w in enumerate(scene.walls):
+        _interval(w.x, f"walls[{i}].x")
+        _interval(w.z, f"walls[{i}].z")
+        if w.ramp_time < 0 or w.ramp_delay < 0:
+            raise SceneError(f"walls[{i}] ({w.name}): ramp_time and ramp_delay must be >= 0")
+        for j, b in enumerate(scene.fluid.blocks):
+            if w.overlap_area(b) > 1e-12 * scene.dp ** 2:
+                raise SceneError(
+                    f"walls[{i}] ({w.name}): overlaps fluid.blocks[{j}]; "
+                    "walls and fluid must not share area")
+    if scene.periodic_x is not None:
+        _interval(scene.periodic_x, "periodic_x")
+        x0, x1 = scene.periodic_x
+        period = x1 - x0
+        if period < 3 * 2 * scene.h:
+            raise SceneError(f"periodic_x: the period must hold at least 3 kernel supports (6 h = {6 * scene.h:g} m)")
+        n = period / scene.dp
+        if abs(n - round(n)) > 1e-6:
+            raise SceneError(f"periodic_x: the period {period:g} m must be a whole number of dp")
+        for i, r in enumerate(list(scene.fluid.blocks) + list(scene.walls)):
+            if r.x[0] < x0 - 1e-12 or r.x[1] > x1 + 1e-12:
+                raise SceneError(f"periodic_x: every block and wall must lie within {list(scene.periodic_x)}")
+    if scene.domain is not None:
+        _interval(scene.domain.x, "domain.x")
+        _interval(scene.domain.z, "domain.z")
+    n = scene.estimated_particles()
+    need = n * BYTES_PER_PARTICLE / 1e9
+    if need > scene.memory_budget_gb:
+        raise SceneError(
+            f"dp: {n} particles need about {need:.1f} GB, over memory_budget_gb = "
+            f"{scene.memory_budget_gb:g}; raise dp or the budget")

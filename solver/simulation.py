@@ -1,0 +1,223 @@
+"""A running simulation: particle state kept sorted by cell, one step at a time."""
+from __future__ import annotations
+
+import math
+import sys
+import time as _time
+from dataclasses import dataclass, field
+
+import numba as nb
+import numpy as np
+
+from . import boundary, cells, forces, guards, integrate, shifting
+from .build import Particles, build_particles
+from .scene import Scene
+
+_SORTED = ("x", "z", "u", "w", "rho", "drho_prev", "kind", "wall", "gx", "gz", "pid")
+
+
+def default_domain(scene: Scene) -> tuple[float, float, float, float]:
+    """Fluid and walls' bounding box, 4h beyond on the sides and below, and half the
+    height (at least 4h) above."""
+    rects = list(scene.fluid.blocks) + list(scene.walls)
+    x0 = min(r.x[0] for r in rects)
+    x1 = max(r.x[1] for r in rects)
+    z0 = min(r.z[0] for r in rects)
+    z1 = max(r.z[1] for r in rects)
+    m = 4.0 * scene.h
+    if scene.domain is not None:
+        x0, x1, z0, z1 = (*scene.domain.x, *scene.domain.z)
+    else:
+        x0, x1, z0, z1 = x0 - m, x1 + m, z0 - m, z1 + max(0.5 * (z1 - z0), m)
+    if scene.periodic_x is not None:
+        x0, x1 = scene.periodic_x
+    return x0, x1, z0, z1
+
+
+@dataclass
+class StepInfo:
+    dt: float = 0.0
+    limit: int = 0
+    dt_limits: tuple = (0.0, 0.0, 0.0)
+
+
+class Simulation:
+    """Owns the particle arrays and advances them by SPEC section 6."""
+
+    def __init__(self, scene: Scene, particles: Particles | None = None):
+        self.scene = scene
+        p = particles if particles is not None else build_particles(scene)
+        self.n = p.n
+        self.x, self.z, self.u, self.w = p.x.copy(), p.z.copy(), p.u.copy(), p.w.copy()
+        self.rho = p.rho.copy()
+        self.kind, self.wall, self.pid = p.kind.copy(), p.wall.copy(), p.pid.copy()
+        self.gx, self.gz = p.gx.copy(), p.gz.copy()
+        self.drho_prev = np.zeros(self.n)
+        self.n_fluid = int((self.kind == 0).sum())
+
+        s = scene
+        self.h, self.rho0, self.c0, self.nu = s.h, s.fluid.density, s.c0, s.nu
+        self.mass = self.rho0 * s.dp * s.dp
+        self.B = self.c0 ** 2 * self.rho0 / 7.0
+        self.delta = s.physics.density_diffusion or 0.0
+        self.diffusion = self.delta > 0
+        self.shift_method = s.physics.shifting.method
+        self.nq = forces.NQ if self.shift_method != "none" else 3
+        self.pair_loop = forces.make_pair_loop(self.diffusion, self.shift_method != "none")
+        self.mdbc = s.physics.boundary == "mdbc"
+
+        x0, x1, z0, z1 = default_domain(s)
+        self.domain = (x0, x1, z0, z1)
+        self.grid = cells.Grid.cover(x0, x1, z0, z1, 2.0 * self.h, s.periodic_x is not None)
+        self.walls = np.array([[w.x[0], w.x[1], w.z[0], w.z[1]] for w in s.walls]).reshape(-1, 4)
+        self.moving = np.array([w.moving for w in s.walls] or [False])
+
+        self.nthreads = nb.get_num_threads()
+        self.acc = np.zeros((self.nthreads, self.nq, self.n))
+        self.out = np.zeros((self.nq, self.n))
+        self.vmax_t = np.zeros(self.nthreads)
+        self.split = np.zeros(self.nthreads + 1, dtype=np.int64)
+        self.cell = np.zeros(self.n, dtype=np.int64)
+        self.order = np.zeros(self.n, dtype=np.int64)
+        self.start = np.zeros(self.grid.ncells + 2, dtype=np.int64)
+        self.p = np.zeros(self.n)
+        self.shift_dx = np.zeros(self.n)
+        self.shift_dz = np.zeros(self.n)
+        self._buf = {np.dtype(a.dtype): np.empty(self.n, a.dtype)
+                     for a in (self.x, self.kind, self.wall, self.pid)}
+        self.health = np.zeros(4)
+        self.n_active = self.n
+
+        self.t = 0.0
+        self.steps = 0
+        self.info = StepInfo()
+        self.reason = ""
+        self._evaluate(0.0)
+        self.drho_prev[:] = self.out[2]
+        self._update_dt()
+        self.dt_first = self.info.dt
+
+    # ---- pieces of a step -----------------------------------------------------
+    def _sort(self) -> str:
+        g = self.grid
+        bad = cells.assign_cells(self.x, self.z, self.kind, g.x0, g.z0, g.csx, g.csz,
+                                 g.ncx, g.ncz, self.cell)
+        if bad >= 0:
+            return (f"a fluid particle left the domain x in [{self.domain[0]:.4g}, {self.domain[1]:.4g}], "
+                    f"z in [{self.domain[2]:.4g}, {self.domain[3]:.4g}] m at "
+                    f"({self.x[bad]:.4g}, {self.z[bad]:.4g})")
+        cells.counting_sort(self.cell, g.ncells + 1, self.order, self.start)
+        for name in _SORTED:
+            arr = getattr(self, name)
+            buf = self._buf.setdefault(np.dtype(arr.dtype), np.empty(self.n, arr.dtype))
+            cells.gather(arr, self.order, buf)
+            setattr(self, name, buf)
+            self._buf[np.dtype(arr.dtype)] = arr
+        self.n_active = int(self.start[g.ncells])
+        self.drho_prev[self.n_active:] = 0.0
+        cells.column_split(self.start, g.ncx, g.ncz, self.nthreads, self.split)
+        return ""
+
+    def _evaluate(self, t: float) -> str:
+        """Sort, set wall particles, and compute accelerations and drho/dt at time t."""
+        reason = self._sort()
+        if reason:
+            return reason
+        g, s = self.grid, self.scene
+        vwall = boundary.wall_velocities(s.walls, t)
+        if self.mdbc:
+            boundary.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.kind, self.wall,
+                                 self.gx, self.gz, vwall, self.start, self.n_active,
+                                 g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
+                                 self.h, self.mass, self.rho0)
+        else:
+            boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
+        forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
+        self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.kind, self.start,
+                       g.ncx, g.ncz, g.periodic, g.period, self.split, self.h, self.mass,
+                       self.nu, self.h * self.c0, self.rho0, self.rho0 * s.gravity[1] / self.B,
+                       self.delta, self.acc, self.vmax_t)
+        self.amax = forces.reduce_accumulators(self.acc, self.kind, s.gravity[0], s.gravity[1],
+                                               self.out, self.nq)
+        self.vmax = float(self.vmax_t.max())
+        return ""
+
+    def _update_dt(self):
+        dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0, self.nu)
+        self.info = StepInfo(dt, k, lim)
+
+    def _shift(self, dt: float):
+        sh, g = self.scene.physics.shifting, self.grid
+        A = self.scene.shifting_coefficient
+        gcx, gcz, divr = self.out[3], self.out[4], self.out[5]
+        if self.shift_method == "skillen":
+            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, self.n_active, A,
+                                   self.h, dt, sh.surface_threshold, sh.max_shift * self.scene.dp,
+                                   self.shift_dx, self.shift_dz)
+        else:
+            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, divr, self.start, self.n_active,
+                                g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0, g.csx, g.csz,
+                                0.5 * A * self.h * self.h, self.h, sh.surface_threshold,
+                                self.shift_dx, self.shift_dz)
+        self.x[:self.n_active] += self.shift_dx[:self.n_active]
+        self.z[:self.n_active] += self.shift_dz[:self.n_active]
+
+    def _wrap(self):
+        if self.grid.periodic:
+            integrate.wrap_periodic(self.x, self.gx, self.grid.x0, self.grid.period)
+
+    # ---- one step -------------------------------------------------------------
+    def step(self, dt: float | None = None) -> str:
+        """Advance by dt (default: the CFL step). Returns a divergence reason or ''."""
+        dt = self.info.dt if dt is None else dt
+        s = self.scene
+        t = self.t
+        vw = boundary.wall_velocities(s.walls, t)
+        integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
+                        vw, self.moving, 0.5 * dt, self.n)
+        integrate.advance_density(self.rho, self.drho_prev, self.n_active, 0.5 * dt)
+        self._wrap()
+        reason = self._evaluate(t + 0.5 * dt)
+        if reason:
+            return self._stop(reason)
+        integrate.kick(self.u, self.w, self.rho, self.kind, self.out[0], self.out[1], self.out[2],
+                       self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc)
+        vw = boundary.wall_velocities(s.walls, t + dt)
+        integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
+                        vw, self.moving, 0.5 * dt, self.n)
+        if self.shift_method != "none":
+            self._shift(dt)
+        self._wrap()
+        self.t = t + dt
+        self.steps += 1
+        reason = guards.check(self.check_health(), s.guards, s.dp)
+        if reason:
+            return self._stop(reason)
+        self._update_dt()
+        reason = guards.check_dt(self.info.dt, self.dt_first, s.guards)
+        if reason:
+            return self._stop(reason)
+        return ""
+
+    def _stop(self, reason: str) -> str:
+        self.reason = f"t = {self.t:.6g} s, step {self.steps}: {reason}"
+        return self.reason
+
+    def check_health(self) -> np.ndarray:
+        g = self.grid
+        guards.fluid_health(self.x, self.z, self.u, self.w, self.rho, self.kind, self.n_active,
+                            self.rho0, self.walls, g.periodic, g.x0, g.period, self.health)
+        return self.health
+
+    # ---- views -----------------------------------------------------------------
+    def pressure(self) -> np.ndarray:
+        forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
+        return self.p
+
+    def snapshot(self) -> dict[str, np.ndarray]:
+        """Particle fields in original particle order (fluid first, then walls)."""
+        inv = np.empty(self.n, dtype=np.int64)
+        inv[self.pid] = np.arange(self.n)
+        p = self.pressure()
+        return {k: v[inv].copy() for k, v in
+                dict(x=self.x, z=self.z, u=self.u, w=self.w, rho=self.rho, p=p, kind=self.kind).items()}
