@@ -40,8 +40,8 @@ def dbc_velocity(kind, wall, vwall, u, w, n_active):
 
 
 @nb.njit(parallel=True, cache=True)
-def mdbc_update(x, z, u, w, rho, kind, wall, gxs, gzs, vwall, start, n_active,
-                x0, z0, csx, csz, ncx, ncz, periodic, period, h, mass, rho0):
+def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_active,
+                x0, z0, csx, csz, ncx, ncz, periodic, period, h, rho0):
     """Set density and no-slip velocity of every active boundary particle from its ghost."""
     alpha = 7.0 / (4.0 * math.pi * h * h)
     fac = -5.0 * alpha / (h * h)
@@ -92,7 +92,7 @@ def mdbc_update(x, z, u, w, rho, kind, wall, gxs, gzs, vwall, start, n_active,
                     q = math.sqrt(r2) / h
                     Wv = w_value(q, alpha)
                     F = grad_factor(q, fac)
-                    V = mass / rho[j]
+                    V = mass[j] / rho[j]
                     WV = Wv * V
                     gxv = F * dx * V
                     gzv = F * dz * V

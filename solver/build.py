@@ -19,6 +19,7 @@ class Particles:
     u: np.ndarray
     w: np.ndarray
     rho: np.ndarray
+    mass: np.ndarray  # rho(t=0) dp^2: particle volumes match the lattice
     kind: np.ndarray  # int8: 0 fluid, 1 boundary
     wall: np.ndarray  # int32: wall index, -1 for fluid
     gx: np.ndarray  # ghost node of a boundary particle
@@ -59,40 +60,59 @@ def _inside_any(px, pz, walls, periodic):
     return False
 
 
-def ghost_node(px: float, pz: float, walls, periodic, eps: float) -> tuple[float, float]:
+def _interface_edges(walls, blocks, periodic, eps):
+    """Wall edges that face fluid: the open half-plane beyond the edge holds some fluid
+    block, and the edge is not on a periodic end. Each as ((ax, az), (bx, bz))."""
+    edges = []
+    for w in walls:
+        sides = [  # (edge, does the half-plane beyond it hold fluid?)
+            (((w.x[0], w.z[0]), (w.x[1], w.z[0])), any(b.z[0] < w.z[0] for b in blocks)),
+            (((w.x[0], w.z[1]), (w.x[1], w.z[1])), any(b.z[1] > w.z[1] for b in blocks)),
+            (((w.x[0], w.z[0]), (w.x[0], w.z[1])), any(b.x[0] < w.x[0] for b in blocks)),
+            (((w.x[1], w.z[0]), (w.x[1], w.z[1])), any(b.x[1] > w.x[1] for b in blocks)),
+        ]
+        for edge, faces_fluid in sides:
+            (ax, az), (bx, bz) = edge
+            on_period_end = periodic is not None and ax == bx and (
+                abs(ax - periodic[0]) < eps or abs(ax - periodic[1]) < eps)
+            if faces_fluid and not on_period_end:
+                edges.append(edge)
+    return edges
+
+
+def ghost_node(px: float, pz: float, edges, walls, periodic, eps: float) -> tuple[float, float]:
     """Mirror of (px, pz) through the nearest point of the wall/fluid interface.
 
-    Candidates are the projections on every wall edge and every wall corner; a candidate
+    Candidates are the projections on every interface edge and the edge ends; a candidate
     counts when a step beyond it, away from the particle, is outside all walls (so shared
-    edges between touching walls are skipped and inner corners mirror diagonally). Edges on
-    the periodic ends are not interfaces.
+    edges between touching walls are skipped and inner corners mirror diagonally).
+    Returns NaNs when no interface is found.
     """
     best, best_d2 = None, np.inf
-    for w in walls:
-        edges = [((w.x[0], w.z[0]), (w.x[1], w.z[0])), ((w.x[0], w.z[1]), (w.x[1], w.z[1])),
-                 ((w.x[0], w.z[0]), (w.x[0], w.z[1])), ((w.x[1], w.z[0]), (w.x[1], w.z[1]))]
-        for (ax, az), (bx, bz) in edges:
-            if periodic is not None and ax == bx and (abs(ax - periodic[0]) < eps or abs(ax - periodic[1]) < eps):
+    for (ax, az), (bx, bz) in edges:
+        ex, ez = bx - ax, bz - az
+        t = ((px - ax) * ex + (pz - az) * ez) / (ex * ex + ez * ez)
+        for tt in (min(max(t, 0.0), 1.0), 0.0, 1.0):
+            cx, cz = ax + tt * ex, az + tt * ez
+            dx, dz = cx - px, cz - pz
+            d2 = dx * dx + dz * dz
+            if d2 >= best_d2 or d2 == 0.0:
                 continue
-            ex, ez = bx - ax, bz - az
-            t = ((px - ax) * ex + (pz - az) * ez) / (ex * ex + ez * ez)
-            for tt in (min(max(t, 0.0), 1.0), 0.0, 1.0):
-                cx, cz = ax + tt * ex, az + tt * ez
-                dx, dz = cx - px, cz - pz
-                d2 = dx * dx + dz * dz
-                if d2 >= best_d2 or d2 == 0.0:
-                    continue
-                d = np.sqrt(d2)
-                if _inside_any(cx + eps * dx / d, cz + eps * dz / d, walls, periodic):
-                    continue
-                best, best_d2 = (cx, cz), d2
+            d = np.sqrt(d2)
+            if _inside_any(cx + eps * dx / d, cz + eps * dz / d, walls, periodic):
+                continue
+            best, best_d2 = (cx, cz), d2
     if best is None:
         return np.nan, np.nan
     return 2 * best[0] - px, 2 * best[1] - pz
 
 
 def build_particles(scene: Scene) -> Particles:
-    """Fill fluid blocks and walls on the dp lattice; fluid starts hydrostatic if g_z != 0."""
+    """Fill fluid blocks and walls on the dp lattice.
+
+    Density starts hydrostatic below the highest fluid top (bed-normal gravity), walls
+    included; each particle's mass is rho dp^2 so that m/rho is the lattice cell volume.
+    """
     dp = scene.dp
     fx, fz, fu, fw = [], [], [], []
     for b in scene.fluid.blocks:
@@ -114,15 +134,18 @@ def build_particles(scene: Scene) -> Particles:
         bx, bz, bwall = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int32)
     gx = np.full(bx.size, np.nan)
     gz = np.full(bx.size, np.nan)
+    eps = 1e-6 * dp
+    edges = _interface_edges(scene.walls, scene.fluid.blocks, scene.periodic_x, eps)
     for k in range(bx.size):
-        gx[k], gz[k] = ghost_node(bx[k], bz[k], scene.walls, scene.periodic_x, 1e-6 * dp)
-    brho = np.full(bx.size, scene.fluid.density)
+        gx[k], gz[k] = ghost_node(bx[k], bz[k], edges, scene.walls, scene.periodic_x, eps)
+    brho = hydrostatic_density(scene, bz, top)
 
     nf, nb = fx.size, bx.size
     return Particles(
         x=np.concatenate([fx, bx]), z=np.concatenate([fz, bz]),
         u=np.concatenate([fu, np.zeros(nb)]), w=np.concatenate([fw, np.zeros(nb)]),
         rho=np.concatenate([frho, brho]),
+        mass=np.concatenate([frho, brho]) * dp * dp,
         kind=np.concatenate([np.full(nf, FLUID, np.int8), np.full(nb, BOUNDARY, np.int8)]),
         wall=np.concatenate([np.full(nf, -1, np.int32), bwall]),
         gx=np.concatenate([np.full(nf, np.nan), gx]), gz=np.concatenate([np.full(nf, np.nan), gz]),

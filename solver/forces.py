@@ -8,8 +8,8 @@ Density diffusion and the shifting sums are compiled in or out (``make_pair_loop
 
   drho_a/dt = rho_a sum_b u_ab.gradW_ab V_b + h c0 D_a
   D_a = 2 delta sum_b ((rho_a - rho_b) - rho_ab^H) (r_ab.gradW_ab) / (r^2 + eta^2) V_b
-  du_a/dt = -sum_b m (P_a + P_b)/(rho_a rho_b) gradW_ab
-            + sum_b m 4 nu (r_ab.gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)) u_ab  (+ g)
+  du_a/dt = -sum_b m_b (P_a + P_b)/(rho_a rho_b) gradW_ab
+            + sum_b m_b 4 nu (r_ab.gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)) u_ab  (+ g)
   gradC_a = sum_b V_b gradW_ab,   div r_a = -sum_b V_b r_ab.gradW_ab
 """
 from __future__ import annotations
@@ -46,8 +46,8 @@ def make_pair_loop(diffusion: bool, shifting: bool):
     """Compile the pair loop with density diffusion and shifting sums in or out."""
 
     @nb.njit(parallel=True, cache=True, fastmath=False)
-    def pair_loop(x, z, u, w, rho, p, kind, start, ncx, ncz, periodic, period, split,
-                  h, mass, nu, hc0, rho0, k_hyd, delta, acc, vmax):
+    def pair_loop(x, z, u, w, rho, p, mass, kind, start, ncx, ncz, periodic, period, split,
+                  h, nu, hc0, rho0, k_hyd, delta, acc, vmax):
         nt = split.size - 1
         fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
         eta2 = 0.01 * h * h
@@ -77,7 +77,7 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                             continue
                         for a in range(start[ca], start[ca + 1]):
                             xa, za, ua, wa = x[a], z[a], u[a], w[a]
-                            ra, pa, ka = rho[a], p[a], kind[a]
+                            ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
                             first = a + 1 if k == 0 else b0
                             for b in range(first, b1):
                                 kb = kind[b]
@@ -94,22 +94,23 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                                 dw = wa - w[b]
                                 vdotr = du * dx + dw * dz
                                 rdotg = F * r2
-                                Va = mass / ra
-                                Vb = mass / rb
+                                mb = mass[b]
+                                Va = ma / ra
+                                Vb = mb / rb
                                 inv_r2e = 1.0 / (r2 + eta2)
                                 # continuity
                                 udotg = F * vdotr
                                 acc[t, 2, a] += ra * udotg * Vb
                                 acc[t, 2, b] += rb * udotg * Va
                                 # pressure and laminar viscosity
-                                pt = mass * (pa + p[b]) / (ra * rb) * F
-                                vt = mass * 4.0 * nu * rdotg / ((ra + rb)) * inv_r2e
+                                pt = (pa + p[b]) / (ra * rb) * F
+                                vt = 4.0 * nu * rdotg / (ra + rb) * inv_r2e
                                 fx = -pt * dx + vt * du
                                 fz = -pt * dz + vt * dw
-                                acc[t, 0, a] += fx
-                                acc[t, 1, a] += fz
-                                acc[t, 0, b] -= fx
-                                acc[t, 1, b] -= fz
+                                acc[t, 0, a] += mb * fx
+                                acc[t, 1, a] += mb * fz
+                                acc[t, 0, b] -= ma * fx
+                                acc[t, 1, b] -= ma * fz
                                 vr = abs(h * vdotr * inv_r2e)
                                 if vr > vm:
                                     vm = vr

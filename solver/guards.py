@@ -8,12 +8,12 @@ import numpy as np
 
 
 @nb.njit(parallel=True, cache=True)
-def fluid_health(x, z, u, w, rho, kind, n, rho0, walls, periodic, px0, period, out):
+def fluid_health(x, z, u, w, rho, mass, kind, n, rho0, walls, periodic, px0, period, out):
     """One pass over fluid particles.
 
     out[0]: number of non-finite fluid values, out[1]: max |rho/rho0 - 1|,
     out[2]: max depth of a fluid particle inside a wall rectangle (0 if none),
-    out[3]: kinetic energy per unit mass sum 0.5 |v|^2.
+    out[3]: kinetic energy sum 0.5 m |v|^2.
     """
     nbad = np.zeros(n)
     dev = np.zeros(n)
@@ -27,7 +27,7 @@ def fluid_health(x, z, u, w, rho, kind, n, rho0, walls, periodic, px0, period, o
             nbad[i] = 1.0
             continue
         dev[i] = abs(rho[i] / rho0 - 1.0)
-        ke[i] = 0.5 * (u[i] * u[i] + w[i] * w[i])
+        ke[i] = 0.5 * mass[i] * (u[i] * u[i] + w[i] * w[i])
         xi = x[i]
         if periodic:
             xi = px0 + (xi - px0) % period

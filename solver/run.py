@@ -60,7 +60,7 @@ def _record(sim: Simulation, res: RunResult):
     d["dt_limit"].append(sim.info.limit)
     for k, v in zip(("dt_force", "dt_acoustic", "dt_viscous"), sim.info.dt_limits):
         d[k].append(v)
-    d["kinetic_energy"].append(h[3] * sim.mass)
+    d["kinetic_energy"].append(h[3])
     d["max_density_deviation"].append(h[1])
     d["max_penetration"].append(h[2])
     d["n_fluid"].append(sim.n_fluid)

@@ -13,7 +13,7 @@ from . import boundary, cells, forces, guards, integrate, shifting
 from .build import Particles, build_particles
 from .scene import Scene
 
-_SORTED = ("x", "z", "u", "w", "rho", "drho_prev", "kind", "wall", "gx", "gz", "pid")
+_SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "pid")
 
 
 def default_domain(scene: Scene) -> tuple[float, float, float, float]:
@@ -49,7 +49,7 @@ class Simulation:
         p = particles if particles is not None else build_particles(scene)
         self.n = p.n
         self.x, self.z, self.u, self.w = p.x.copy(), p.z.copy(), p.u.copy(), p.w.copy()
-        self.rho = p.rho.copy()
+        self.rho, self.mass = p.rho.copy(), p.mass.copy()
         self.kind, self.wall, self.pid = p.kind.copy(), p.wall.copy(), p.pid.copy()
         self.gx, self.gz = p.gx.copy(), p.gz.copy()
         self.drho_prev = np.zeros(self.n)
@@ -57,7 +57,6 @@ class Simulation:
 
         s = scene
         self.h, self.rho0, self.c0, self.nu = s.h, s.fluid.density, s.c0, s.nu
-        self.mass = self.rho0 * s.dp * s.dp
         self.B = self.c0 ** 2 * self.rho0 / 7.0
         self.delta = s.physics.density_diffusion or 0.0
         self.diffusion = self.delta > 0
@@ -126,15 +125,15 @@ class Simulation:
         g, s = self.grid, self.scene
         vwall = boundary.wall_velocities(s.walls, t)
         if self.mdbc:
-            boundary.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.kind, self.wall,
-                                 self.gx, self.gz, vwall, self.start, self.n_active,
+            boundary.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
+                                 self.wall, self.gx, self.gz, vwall, self.start, self.n_active,
                                  g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
-                                 self.h, self.mass, self.rho0)
+                                 self.h, self.rho0)
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
-        self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.kind, self.start,
-                       g.ncx, g.ncz, g.periodic, g.period, self.split, self.h, self.mass,
+        self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
+                       self.start, g.ncx, g.ncz, g.periodic, g.period, self.split, self.h,
                        self.nu, self.h * self.c0, self.rho0, self.rho0 * s.gravity[1] / self.B,
                        self.delta, self.acc, self.vmax_t)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, s.gravity[0], s.gravity[1],
@@ -205,7 +204,7 @@ class Simulation:
 
     def check_health(self) -> np.ndarray:
         g = self.grid
-        guards.fluid_health(self.x, self.z, self.u, self.w, self.rho, self.kind, self.n_active,
+        guards.fluid_health(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind, self.n_active,
                             self.rho0, self.walls, g.periodic, g.x0, g.period, self.health)
         return self.health
 

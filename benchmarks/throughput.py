@@ -1,0 +1,79 @@
+"""Particle-steps per second of the solver on a viscous layer over a no-slip bed.
+
+Layer: rho 1383, mu 5.6, slope 15.3 deg, periodic in x, ~40k particles (fluid + bed),
+mDBC and density diffusion on. One JSON object per configuration on stdout:
+  {"ch", "threads", "particles", "shifting", "steps", "wall_s", "particle_steps_per_s", ...}
+particle_steps_per_s = (all particles, fluid and boundary) x steps / wall seconds.
+
+Usage: python benchmarks/throughput.py [--steps 200] [--ch 1.5 1.8] [--threads 1 2]
+                                       [--shifting none lind skillen] [--particles 40000]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+
+import numba
+
+from solver.scene import scene_from_dict
+from solver.simulation import Simulation
+
+
+def layer_scene(ch: float, shifting: str, particles: int, dp: float = 1.0e-3) -> dict:
+    """A periodic viscous layer whose fluid + bed particle count is close to ``particles``."""
+    depth_n = 100
+    bed_n = int(math.ceil(2 * ch))
+    length_n = int(round(particles / (depth_n + bed_n)))
+    L, H, T = length_n * dp, depth_n * dp, bed_n * dp
+    theta = math.radians(15.3)
+    return {
+        "name": f"layer-ch{ch}-{shifting}",
+        "dp": dp, "ch": ch,
+        "fluid": {"density": 1383.0, "viscosity": 5.6,
+                  "blocks": [{"x": [0.0, L], "z": [0.0, H]}]},
+        "walls": [{"name": "bed", "x": [0.0, L], "z": [-T, 0.0]}],
+        "gravity": [9.81 * math.sin(theta), -9.81 * math.cos(theta)],
+        "sound": {"coefsound": 10.0, "depth": H},
+        "cfl": 0.2,
+        "periodic_x": [0.0, L],
+        "physics": {"boundary": "mdbc", "density_diffusion": 0.1,
+                    "shifting": {"method": shifting}},
+        "time": {"end": 1.0, "output_interval": 1.0},
+    }
+
+
+def measure(ch: float, threads: int, shifting: str, steps: int, particles: int) -> dict:
+    numba.set_num_threads(threads)
+    sim = Simulation(scene_from_dict(layer_scene(ch, shifting, particles)))
+    for _ in range(5):  # warm-up (compilation is cached after the first configuration)
+        sim.step()
+    tic = time.perf_counter()
+    for _ in range(steps):
+        reason = sim.step()
+        if reason:
+            raise RuntimeError(reason)
+    wall = time.perf_counter() - tic
+    return {"ch": ch, "threads": threads, "particles": sim.n, "fluid": sim.n_fluid,
+            "shifting": shifting, "steps": steps, "wall_s": round(wall, 4),
+            "particle_steps_per_s": round(sim.n * steps / wall),
+            "steps_per_s": round(steps / wall, 1)}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--steps", type=int, default=200)
+    ap.add_argument("--ch", type=float, nargs="+", default=[1.5, 1.8])
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--shifting", nargs="+", default=["none", "lind", "skillen"])
+    ap.add_argument("--particles", type=int, default=40000)
+    a = ap.parse_args(argv)
+    for ch in a.ch:
+        for shifting in a.shifting:
+            for threads in a.threads:
+                print(json.dumps(measure(ch, threads, shifting, a.steps, a.particles)), flush=True)
+
+
+if __name__ == "__main__":
+    main()
