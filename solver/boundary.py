@@ -5,7 +5,8 @@ first-order corrected interpolation of the fluid density at g,
   [sum W V, sum (r_j - r_g) W V; sum gradW V, sum gradW (r_j - r_g)^T V] [rho_g; grad rho]
       = [sum rho_j W V; sum rho_j gradW V],
 (Shepard rho_g where the matrix is near-singular), extrapolated rho_b = rho_g + (r_b - r_g).grad rho;
-no-slip velocity v_b = 2 v_wall - v_g with v_g the Shepard-interpolated fluid velocity.
+no-slip velocity v_b = 2 v_wall - v_g with v_g the Shepard-interpolated fluid velocity
+(or, as an option, interpolated with the same first-order correction as the density).
 """
 from __future__ import annotations
 
@@ -39,10 +40,26 @@ def dbc_velocity(kind, wall, vwall, u, w, n_active):
             w[i] = vwall[wall[i], 1]
 
 
+@nb.njit(inline="always", cache=True)
+def _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, b0, b1, b2):
+    """Solution of the 3x3 system A y = b by Cramer's rule, given det A."""
+    y0 = (b0 * (a11 * a22 - a12 * a21) - a01 * (b1 * a22 - a12 * b2)
+          + a02 * (b1 * a21 - a11 * b2)) / det
+    y1 = (a00 * (b1 * a22 - a12 * b2) - b0 * (a10 * a22 - a12 * a20)
+          + a02 * (a10 * b2 - b1 * a20)) / det
+    y2 = (a00 * (a11 * b2 - b1 * a21) - a01 * (a10 * b2 - b1 * a20)
+          + b0 * (a10 * a21 - a11 * a20)) / det
+    return y0, y1, y2
+
+
 @nb.njit(parallel=True, cache=True)
 def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_active,
-                x0, z0, csx, csz, ncx, ncz, periodic, period, h, rho0):
-    """Set density and no-slip velocity of every active boundary particle from its ghost."""
+                x0, z0, csx, csz, ncx, ncz, periodic, period, h, rho0, corrected_velocity):
+    """Set density and no-slip velocity of every active boundary particle from its ghost.
+
+    v_g is Shepard-interpolated (SPEC), or first-order corrected like the density when
+    ``corrected_velocity`` (and the matrix is well conditioned).
+    """
     alpha = 7.0 / (4.0 * math.pi * h * h)
     fac = -5.0 * alpha / (h * h)
     four_h2 = 4.0 * h * h
@@ -63,6 +80,7 @@ def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_act
         a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
         b0 = b1 = b2 = 0.0
         su = sw = 0.0
+        bu1 = bu2 = bw1 = bw2 = 0.0
         for ddx in range(-1, 2):
             jx = ix + ddx
             shift = 0.0
@@ -111,6 +129,10 @@ def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_act
                     b2 += rho[j] * gzv * h
                     su += u[j] * WV
                     sw += w[j] * WV
+                    bu1 += u[j] * gxv * h
+                    bu2 += u[j] * gzv * h
+                    bw1 += w[j] * gxv * h
+                    bw2 += w[j] * gzv * h
         if a00 <= 0.0:
             rho[i] = rho0
             u[i] = vwx
@@ -118,26 +140,21 @@ def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_act
             continue
         det = (a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20)
                + a02 * (a10 * a21 - a11 * a20))
-        if abs(det) >= DET_MIN:
-            rg = (b0 * (a11 * a22 - a12 * a21) - a01 * (b1 * a22 - a12 * b2)
-                  + a02 * (b1 * a21 - a11 * b2)) / det
-            gdx = (a00 * (b1 * a22 - a12 * b2) - b0 * (a10 * a22 - a12 * a20)
-                   + a02 * (a10 * b2 - b1 * a20)) / det / h
-            gdz = (a00 * (a11 * b2 - b1 * a21) - a01 * (a10 * b2 - b1 * a20)
-                   + b0 * (a10 * a21 - a11 * a20)) / det / h
-            xb = x[i]
-            if periodic:
-                xb = x0 + (xb - x0) % period
-                ddxg = xb - gx
-                if ddxg > 0.5 * period:
-                    ddxg -= period
-                elif ddxg < -0.5 * period:
-                    ddxg += period
-            else:
-                ddxg = xb - gx
-            rb = rg + ddxg * gdx + (z[i] - gz) * gdz
+        well_posed = abs(det) >= DET_MIN
+        if well_posed:
+            rg, gdx, gdz = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, b0, b1, b2)
+            ddxg = x[i] - gx
+            if periodic:  # nearest image
+                ddxg -= period * math.floor(ddxg / period + 0.5)
+            rb = rg + (ddxg * gdx + (z[i] - gz) * gdz) / h
         else:
             rb = b0 / a00
+        if corrected_velocity and well_posed:
+            ug = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0]
+            wg = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0]
+        else:
+            ug = su / a00
+            wg = sw / a00
         rho[i] = rb
-        u[i] = 2.0 * vwx - su / a00
-        w[i] = 2.0 * vwz - sw / a00
+        u[i] = 2.0 * vwx - ug
+        w[i] = 2.0 * vwz - wg

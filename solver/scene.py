@@ -14,6 +14,7 @@ import yaml
 
 SHIFTING_METHODS = ("none", "skillen", "lind")
 BOUNDARY_METHODS = ("mdbc", "dbc")
+MDBC_VELOCITY = ("shepard", "corrected")
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
 
 
@@ -89,6 +90,7 @@ class Shifting:
 @dataclass
 class Physics:
     boundary: str = "mdbc"
+    mdbc_velocity: str = "shepard"  # ghost velocity: shepard (SPEC) or corrected (first order)
     density_diffusion: float | None = 0.1  # delta; null/false switches it off
     shifting: Shifting = field(default_factory=Shifting)
 
@@ -292,6 +294,9 @@ def validate(scene: Scene) -> None:
     if ph.boundary not in BOUNDARY_METHODS:
         raise SceneError(
             f"physics.boundary: {ph.boundary!r} is not one of {', '.join(BOUNDARY_METHODS)}")
+    if ph.mdbc_velocity not in MDBC_VELOCITY:
+        raise SceneError(
+            f"physics.mdbc_velocity: {ph.mdbc_velocity!r} is not one of {', '.join(MDBC_VELOCITY)}")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
     sh = ph.shifting

@@ -128,7 +128,7 @@ class Simulation:
             boundary.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
                                  self.wall, self.gx, self.gz, vwall, self.start, self.n_active,
                                  g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
-                                 self.h, self.rho0)
+                                 self.h, self.rho0, s.physics.mdbc_velocity == "corrected")
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
