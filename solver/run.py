@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numba as nb
 import numpy as np
 
+from . import guards
 from .scene import Scene
 from .simulation import Simulation
 
@@ -77,7 +78,10 @@ def run_scene(scene: Scene, quiet: bool = True, sim: Simulation | None = None) -
     next_out, next_diag = 0.0, 0.0
     eps = 1e-9 * tm.end
     progress = Progress(tm.end, quiet)
-    while True:
+    reason = guards.check(sim.check_health(), scene.guards, scene.dp)
+    if reason:
+        res.status, res.reason = "diverged", f"initial state: {reason}"
+    while not reason:
         if sim.t >= next_diag - eps:
             _record(sim, res)
             next_diag += diag_every
@@ -91,7 +95,6 @@ def run_scene(scene: Scene, quiet: bool = True, sim: Simulation | None = None) -
         reason = sim.step(min(sim.info.dt, target - sim.t))
         if reason:
             res.status, res.reason = "diverged", reason
-            break
         progress(sim)
     progress(sim, force=True)
     res.steps = sim.steps

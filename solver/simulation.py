@@ -208,6 +208,28 @@ class Simulation:
                             self.rho0, self.walls, g.periodic, g.x0, g.period, self.health)
         return self.health
 
+    # ---- for tests and tools -------------------------------------------------------
+    def derivatives(self) -> dict[str, np.ndarray]:
+        """Evaluate at the current state; ax, az, drho (and gradC_x, gradC_z, div_r with
+        shifting on), in original particle order."""
+        reason = self._evaluate(self.t)
+        if reason:
+            raise RuntimeError(reason)
+        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r")[:self.nq]
+        inv = self._inverse_order()
+        return {k: self.out[q][inv].copy() for q, k in enumerate(names)}
+
+    def shift_only(self, dt: float) -> None:
+        """Apply one shifting displacement (no time integration), as if over a step dt."""
+        self._evaluate(self.t)
+        self._shift(dt)
+        self._wrap()
+
+    def _inverse_order(self) -> np.ndarray:
+        inv = np.empty(self.n, dtype=np.int64)
+        inv[self.pid] = np.arange(self.n)
+        return inv
+
     # ---- views -----------------------------------------------------------------
     def pressure(self) -> np.ndarray:
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
@@ -215,8 +237,7 @@ class Simulation:
 
     def snapshot(self) -> dict[str, np.ndarray]:
         """Particle fields in original particle order (fluid first, then walls)."""
-        inv = np.empty(self.n, dtype=np.int64)
-        inv[self.pid] = np.arange(self.n)
+        inv = self._inverse_order()
         p = self.pressure()
         return {k: v[inv].copy() for k, v in
                 dict(x=self.x, z=self.z, u=self.u, w=self.w, rho=self.rho, p=p, kind=self.kind).items()}

@@ -1,0 +1,64 @@
+"""CLI and NetCDF output: variables, units, status, atomic write."""
+import subprocess
+import sys
+
+import numpy as np
+import xarray as xr
+
+from solver.output import write_atomic
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "solver", *args], capture_output=True, text=True)
+
+
+def test_cli_writes_complete_netcdf(tmp_path, examples_dir):
+    out = tmp_path / "sub" / "couette.nc"
+    p = run_cli("run", str(examples_dir / "couette.yaml"), "-o", str(out), "--threads", "1", "--quiet")
+    assert p.returncode == 0, p.stderr
+    ds = xr.open_dataset(out)
+    assert ds.attrs["status"] == "completed" and ds.attrs["reason"] == ""
+    assert ds.attrs["threads"] == 1 and ds.attrs["steps"] > 0 and ds.attrs["wall_time_s"] > 0
+    assert "name: couette" in ds.attrs["scene_yaml"]
+    assert ds.attrs["version_numba"]
+    for v in ("dt", "dt_limit", "dt_force", "dt_acoustic", "dt_viscous", "kinetic_energy",
+              "max_density_deviation", "n_fluid"):
+        assert v in ds and ds[v].dims == ("time",) and "units" in ds[v].attrs
+    for v in ("x", "z", "u", "w", "rho", "p", "kind"):
+        assert ds[v].dims == ("snapshot", "particle")
+    np.testing.assert_allclose(ds.snapshot_time, np.arange(11) * 0.0225, atol=1e-12)
+    # viscous limit dt3 = h^2/nu governs this scene
+    assert set(np.unique(ds.dt_limit.values)) == {2}
+    assert list(tmp_path.joinpath("sub").iterdir()) == [out]  # no temporary left
+
+
+def test_cli_diverged_run_exit_code_and_file(tmp_path, examples_dir):
+    out = tmp_path / "u.nc"
+    p = run_cli("run", str(examples_dir / "unstable.yaml"), "-o", str(out), "--quiet")
+    assert p.returncode == 3
+    ds = xr.open_dataset(out)
+    assert ds.attrs["status"] == "diverged" and "density" in ds.attrs["reason"]
+    assert np.isfinite(ds.x).all() and np.isfinite(ds.rho).all()
+
+
+def test_cli_bad_thread_count(tmp_path, examples_dir):
+    p = run_cli("run", str(examples_dir / "couette.yaml"), "-o", str(tmp_path / "c.nc"), "--threads", "0")
+    assert p.returncode == 2 and "--threads" in p.stderr
+
+
+def test_write_atomic_keeps_old_file_on_failure(tmp_path):
+    path = tmp_path / "r.nc"
+    write_atomic(xr.Dataset({"a": ("t", [1.0])}), path)
+
+    class Boom(xr.Dataset):
+        __slots__ = ()
+
+        def to_netcdf(self, *a, **k):
+            raise KeyboardInterrupt
+
+    try:
+        write_atomic(Boom({"a": ("t", [2.0])}), path)
+    except KeyboardInterrupt:
+        pass
+    assert xr.open_dataset(path)["a"].values.tolist() == [1.0]
+    assert [p.name for p in tmp_path.iterdir()] == ["r.nc"]
