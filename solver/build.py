@@ -41,12 +41,59 @@ def lattice(rect: Rect, dp: float) -> tuple[np.ndarray, np.ndarray]:
     return X.ravel(), Z.ravel()
 
 
-def hydrostatic_density(scene: Scene, z: np.ndarray, top: float) -> np.ndarray:
+def hydrostatic_density(scene: Scene, z: np.ndarray, top) -> np.ndarray:
     """Tait density of a column at rest with free surface at ``top`` (bed-normal gravity)."""
     rho0, c0 = scene.fluid.density, scene.c0
     B = c0 * c0 * rho0 / 7.0
     p = rho0 * (-scene.gravity[1]) * np.maximum(top - z, 0.0)
     return rho0 * (1.0 + p / B) ** (1.0 / 7.0)
+
+
+def profile_lattice(profile, dp: float) -> tuple[np.ndarray, np.ndarray]:
+    """Lattice points of a profile region: columns dp/2 inside [x0, x1], rows from base + dp/2
+    while below the surface."""
+    nx = int(round((profile.x[1] - profile.x[0]) / dp))
+    xs = profile.x[0] + (np.arange(nx) + 0.5) * dp
+    tops = profile.top(xs)
+    X, Z = [], []
+    for x, top in zip(xs, tops):
+        n = int(np.floor((top - profile.base) / dp + 0.5))
+        if n > 0:
+            X.append(np.full(n, x))
+            Z.append(profile.base + (np.arange(n) + 0.5) * dp)
+    if not X:
+        return np.zeros(0), np.zeros(0)
+    return np.concatenate(X), np.concatenate(Z)
+
+
+def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None) -> np.ndarray:
+    """Free-surface height above each query point: the top (+ dp/2) of the contiguous run of
+    fluid lattice points in its column that starts at or just above it.
+
+    Fluid points are (x, z); queries default to the fluid points themselves.
+    """
+    qx = x if qx is None else qx
+    qz = z if qz is None else qz
+    col = np.round(x / dp).astype(np.int64)
+    order = np.lexsort((z, col))
+    cs, zs = col[order], z[order]
+    # top of each contiguous run (same column, gaps of at most 1.5 dp)
+    n = zs.size
+    run_top = zs.copy()
+    for i in range(n - 2, -1, -1):
+        if cs[i + 1] == cs[i] and zs[i + 1] - zs[i] < 1.5 * dp:
+            run_top[i] = run_top[i + 1]
+    out = np.full(qx.size, -np.inf)
+    qcol = np.round(qx / dp).astype(np.int64)
+    for k in range(qx.size):
+        lo = np.searchsorted(cs, qcol[k], side="left")
+        hi = np.searchsorted(cs, qcol[k], side="right")
+        if lo == hi:
+            continue
+        j = lo + np.searchsorted(zs[lo:hi], qz[k] - 0.5 * dp, side="left")
+        if j < hi and zs[j] - qz[k] < 1.5 * dp:
+            out[k] = run_top[j] + 0.5 * dp
+    return out
 
 
 def _inside_any(px, pz, walls, periodic):
@@ -108,21 +155,22 @@ def ghost_node(px: float, pz: float, edges, walls, periodic, eps: float) -> tupl
 
 
 def build_particles(scene: Scene) -> Particles:
-    """Fill fluid blocks and walls on the dp lattice.
+    """Fill fluid regions and walls on the dp lattice.
 
-    Density starts hydrostatic below the highest fluid top (bed-normal gravity), walls
-    included; each particle's mass is rho dp^2 so that m/rho is the lattice cell volume.
+    Density starts hydrostatic (bed-normal gravity) below the local free surface of each
+    column, for fluid and for the wall particles under it; each particle's mass is
+    rho dp^2 so that m/rho is the lattice cell volume.
     """
     dp = scene.dp
     fx, fz, fu, fw = [], [], [], []
-    for b in scene.fluid.blocks:
-        x, z = lattice(b, dp)
+    regions = [(b, lattice(b, dp)) for b in scene.fluid.blocks] + [
+        (p, profile_lattice(p, dp)) for p in scene.fluid.profiles]
+    for region, (x, z) in regions:
         fx.append(x), fz.append(z)
-        fu.append(np.full(x.size, b.velocity[0])), fw.append(np.full(x.size, b.velocity[1]))
+        fu.append(np.full(x.size, region.velocity[0])), fw.append(np.full(x.size, region.velocity[1]))
     fx, fz = np.concatenate(fx), np.concatenate(fz)
     fu, fw = np.concatenate(fu), np.concatenate(fw)
-    top = max(b.z[1] for b in scene.fluid.blocks)
-    frho = hydrostatic_density(scene, fz, top)
+    frho = hydrostatic_density(scene, fz, column_tops(fx, fz, dp))
 
     bx, bz, bwall = [], [], []
     for i, w in enumerate(scene.walls):
@@ -132,13 +180,16 @@ def build_particles(scene: Scene) -> Particles:
         bx, bz, bwall = np.concatenate(bx), np.concatenate(bz), np.concatenate(bwall)
     else:
         bx, bz, bwall = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int32)
+    # wall particles under fluid: continue the column above the wall top
+    wall_top = np.array([scene.walls[i].z[1] for i in bwall]) if bx.size else np.zeros(0)
+    btop = column_tops(fx, fz, dp, bx, wall_top + 0.5 * dp)
+    brho = hydrostatic_density(scene, bz, np.where(np.isfinite(btop), btop, -np.inf))
     gx = np.full(bx.size, np.nan)
     gz = np.full(bx.size, np.nan)
     eps = 1e-6 * dp
-    edges = _interface_edges(scene.walls, scene.fluid.blocks, scene.periodic_x, eps)
+    edges = _interface_edges(scene.walls, scene.fluid.extents(), scene.periodic_x, eps)
     for k in range(bx.size):
         gx[k], gz[k] = ghost_node(bx[k], bz[k], edges, scene.walls, scene.periodic_x, eps)
-    brho = hydrostatic_density(scene, bz, top)
 
     nf, nb = fx.size, bx.size
     return Particles(

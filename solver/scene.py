@@ -47,6 +47,32 @@ class FluidBlock(Rect):
 
 
 @dataclass
+class FluidProfile:
+    """Fluid between z = ``base`` and a piecewise-linear free surface through the
+    ``surface`` points [[x, z], ...] (x increasing), over [x0, x1]."""
+
+    x: tuple[float, float]
+    base: float
+    surface: list[tuple[float, float]]
+    velocity: tuple[float, float] = (0.0, 0.0)
+
+    def top(self, x):
+        import numpy as np
+        pts = np.asarray(self.surface, dtype=float)
+        return np.interp(x, pts[:, 0], pts[:, 1])
+
+    @property
+    def bbox(self) -> Rect:
+        return Rect(self.x, (self.base, max(z for _, z in self.surface)))
+
+    @property
+    def area(self) -> float:
+        import numpy as np
+        xs = np.linspace(self.x[0], self.x[1], 2001)
+        return float(np.trapezoid(np.maximum(self.top(xs) - self.base, 0.0), xs))
+
+
+@dataclass
 class Wall(Rect):
     """A solid rectangle filled with boundary particles.
 
@@ -67,7 +93,12 @@ class Wall(Rect):
 class Fluid:
     density: float
     viscosity: float  # dynamic viscosity mu [Pa s]
-    blocks: list[FluidBlock]
+    blocks: list[FluidBlock] = field(default_factory=list)
+    profiles: list[FluidProfile] = field(default_factory=list)
+
+    def extents(self) -> list[Rect]:
+        """Bounding rectangles of every fluid region."""
+        return list(self.blocks) + [p.bbox for p in self.profiles]
 
 
 @dataclass
@@ -156,7 +187,8 @@ class Scene:
 
     def estimated_particles(self) -> int:
         cell = self.dp * self.dp
-        n = sum(b.area for b in self.fluid.blocks) + sum(w.area for w in self.walls)
+        n = (sum(b.area for b in self.fluid.blocks) + sum(p.area for p in self.fluid.profiles)
+             + sum(w.area for w in self.walls))
         return int(round(n / cell))
 
     def to_dict(self) -> dict:
@@ -272,8 +304,8 @@ def validate(scene: Scene) -> None:
     _positive(scene.cfl, "cfl")
     _positive(scene.fluid.density, "fluid.density")
     _positive(scene.fluid.viscosity, "fluid.viscosity")
-    if not scene.fluid.blocks:
-        raise SceneError("fluid.blocks: at least one fluid block is required")
+    if not scene.fluid.blocks and not scene.fluid.profiles:
+        raise SceneError("fluid: at least one of fluid.blocks or fluid.profiles is required")
     s = scene.sound
     if s.c0 is not None:
         _positive(s.c0, "sound.c0")
@@ -318,16 +350,27 @@ def validate(scene: Scene) -> None:
     for i, b in enumerate(scene.fluid.blocks):
         _interval(b.x, f"fluid.blocks[{i}].x")
         _interval(b.z, f"fluid.blocks[{i}].z")
+    for i, pr in enumerate(scene.fluid.profiles):
+        key = f"fluid.profiles[{i}]"
+        _interval(pr.x, f"{key}.x")
+        xs = [x for x, _ in pr.surface]
+        if len(xs) < 2 or any(b <= a for a, b in zip(xs, xs[1:])):
+            raise SceneError(f"{key}.surface: needs at least 2 points with increasing x")
+        if xs[0] > pr.x[0] or xs[-1] < pr.x[1]:
+            raise SceneError(f"{key}.surface: the points must span {key}.x")
+        if max(z for _, z in pr.surface) <= pr.base:
+            raise SceneError(f"{key}.surface: lies entirely below {key}.base")
+    regions = [(f"fluid.blocks[{j}]", b) for j, b in enumerate(scene.fluid.blocks)] + [
+        (f"fluid.profiles[{j}]", p.bbox) for j, p in enumerate(scene.fluid.profiles)]
     for i, w in enumerate(scene.walls):
         _interval(w.x, f"walls[{i}].x")
         _interval(w.z, f"walls[{i}].z")
         if w.ramp_time < 0 or w.ramp_delay < 0:
             raise SceneError(f"walls[{i}] ({w.name}): ramp_time and ramp_delay must be >= 0")
-        for j, b in enumerate(scene.fluid.blocks):
+        for key, b in regions:
             if w.overlap_area(b) > 1e-12 * scene.dp ** 2:
                 raise SceneError(
-                    f"walls[{i}] ({w.name}): overlaps fluid.blocks[{j}]; "
-                    "walls and fluid must not share area")
+                    f"walls[{i}] ({w.name}): overlaps {key}; walls and fluid must not share area")
     if scene.periodic_x is not None:
         _interval(scene.periodic_x, "periodic_x")
         x0, x1 = scene.periodic_x
@@ -337,7 +380,7 @@ def validate(scene: Scene) -> None:
         n = period / scene.dp
         if abs(n - round(n)) > 1e-6:
             raise SceneError(f"periodic_x: the period {period:g} m must be a whole number of dp")
-        for i, r in enumerate(list(scene.fluid.blocks) + list(scene.walls)):
+        for r in scene.fluid.extents() + list(scene.walls):
             if r.x[0] < x0 - 1e-12 or r.x[1] > x1 + 1e-12:
                 raise SceneError(f"periodic_x: every block and wall must lie within {list(scene.periodic_x)}")
     if scene.domain is not None:

@@ -19,7 +19,7 @@ _SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx",
 def default_domain(scene: Scene) -> tuple[float, float, float, float]:
     """Fluid and walls' bounding box, 4h beyond on the sides and below, and half the
     height (at least 4h) above."""
-    rects = list(scene.fluid.blocks) + list(scene.walls)
+    rects = scene.fluid.extents() + list(scene.walls)
     x0 = min(r.x[0] for r in rects)
     x1 = max(r.x[1] for r in rects)
     z0 = min(r.z[0] for r in rects)
