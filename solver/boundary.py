@@ -4,7 +4,9 @@ mDBC, for each boundary particle b near fluid, with ghost node g mirrored into t
 first-order corrected interpolation of the fluid density at g,
   [sum W V, sum (r_j - r_g) W V; sum gradW V, sum gradW (r_j - r_g)^T V] [rho_g; grad rho]
       = [sum rho_j W V; sum rho_j gradW V],
-(Shepard rho_g where the matrix is near-singular), extrapolated rho_b = rho_g + (r_b - r_g).grad rho;
+(Shepard rho_g where the matrix is near-singular), extrapolated rho_b = rho_g + (r_b - r_g).grad rho
+and floored at rho0 (a wall pushes, never pulls: near a free surface the interpolation
+would otherwise give wall tension that draws fluid into the wall);
 no-slip velocity v_b = 2 v_wall - v_g with v_g the Shepard-interpolated fluid velocity
 (or, as an option, interpolated with the same first-order correction as the density).
 """
@@ -155,6 +157,6 @@ def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_act
         else:
             ug = su / a00
             wg = sw / a00
-        rho[i] = rb
+        rho[i] = max(rb, rho0)  # walls push, never pull: no tension at a wall
         u[i] = 2.0 * vwx - ug
         w[i] = 2.0 * vwz - wg

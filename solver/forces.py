@@ -3,7 +3,8 @@ Lo & Shao laminar viscosity, and the shifting sums, over a half stencil.
 
 Each pair (a, b) is visited once and its contributions are added to both particles,
 into per-thread accumulators ``acc[t, q, i]`` (no write races), reduced afterwards.
-Quantities q: 0 ax, 1 az, 2 drho/dt, 3 gradC_x, 4 gradC_z, 5 div r.
+Quantities q: 0 ax, 1 az, 2 drho/dt, 3 gradC_x, 4 gradC_z, 5 div r, 6-7 the kernel-weighted
+sum of the inward normals of nearby wall particles (where shifting must not push).
 Density diffusion and the shifting sums are compiled in or out (``make_pair_loop``).
 
   drho_a/dt = rho_a sum_b u_ab.gradW_ab V_b + h c0 D_a
@@ -11,6 +12,9 @@ Density diffusion and the shifting sums are compiled in or out (``make_pair_loop
   du_a/dt = -sum_b m_b (P_a + P_b)/(rho_a rho_b) gradW_ab
             + sum_b m_b 4 nu (r_ab.gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)) u_ab  (+ g)
   gradC_a = sum_b V_b gradW_ab,   div r_a = -sum_b V_b r_ab.gradW_ab
+In the two shifting sums a wall particle's volume is its lattice cell dp^2, not m/rho: the
+mDBC wall density follows the fluid pressure, and a wall that looked less concentrated
+than the fluid beside it would shift fluid into it, step after step.
 """
 from __future__ import annotations
 
@@ -22,7 +26,7 @@ import numpy as np
 
 from .kernel import grad_factor
 
-NQ = 6
+NQ = 8
 # Binomial series of (1 + x)^(1/7) - 1, split into even and odd powers: f(+-x) = E +- O.
 _C = [1.0]
 for _k in range(1, 12):
@@ -46,8 +50,8 @@ def make_pair_loop(diffusion: bool, shifting: bool):
     """Compile the pair loop with density diffusion and shifting sums in or out."""
 
     @nb.njit(parallel=True, cache=True, fastmath=False)
-    def pair_loop(x, z, u, w, rho, p, mass, kind, start, ncx, ncz, periodic, period, split,
-                  h, nu, hc0, rho0, k_hyd, delta, acc, vmax):
+    def pair_loop(x, z, u, w, rho, p, mass, kind, wnx, wnz, start, ncx, ncz, periodic, period, split,
+                  h, nu, hc0, rho0, k_hyd, delta, dp2, acc, vmax):
         nt = split.size - 1
         fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
         eta2 = 0.01 * h * h
@@ -122,12 +126,21 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                                         acc[t, 2, a] += g * (drab - rho0 * fa) * Vb
                                         acc[t, 2, b] += g * (-drab - rho0 * fb) * Va
                                 if shifting:
-                                    acc[t, 3, a] += Vb * F * dx
-                                    acc[t, 4, a] += Vb * F * dz
-                                    acc[t, 3, b] -= Va * F * dx
-                                    acc[t, 4, b] -= Va * F * dz
-                                    acc[t, 5, a] -= Vb * rdotg
-                                    acc[t, 5, b] -= Va * rdotg
+                                    # a wall particle counts with its lattice cell dp^2
+                                    Vsb = dp2 if kb == 1 else Vb
+                                    Vsa = dp2 if ka == 1 else Va
+                                    acc[t, 3, a] += Vsb * F * dx
+                                    acc[t, 4, a] += Vsb * F * dz
+                                    acc[t, 3, b] -= Vsa * F * dx
+                                    acc[t, 4, b] -= Vsa * F * dz
+                                    acc[t, 5, a] -= Vsb * rdotg
+                                    acc[t, 5, b] -= Vsa * rdotg
+                                    if kb == 1:
+                                        acc[t, 6, a] -= F * wnx[b]
+                                        acc[t, 7, a] -= F * wnz[b]
+                                    elif ka == 1:
+                                        acc[t, 6, b] -= F * wnx[a]
+                                        acc[t, 7, b] -= F * wnz[a]
             vmax[t] = vm
 
     return pair_loop

@@ -86,6 +86,11 @@ class Runner:
         self.next_out = self.next_diag = 0.0
         self.next_monitor = [0.0] * len(self.monitors)
         self.done = False
+        self.tic = _time.perf_counter()
+
+    def elapsed(self) -> float:
+        """Wall time of this run so far, earlier (checkpointed) segments included."""
+        return self.res.wall_time + _time.perf_counter() - self.tic
 
     def _record(self):
         sim, res = self.sim, self.res
@@ -117,7 +122,7 @@ class Runner:
         ``on_step(runner)`` is called after every step (checkpointing hooks in here).
         """
         sim, res, tm = self.sim, self.res, self.scene.time
-        tic = _time.perf_counter()
+        tic = self.tic = _time.perf_counter()
         eps = 1e-9 * tm.end
         progress = Progress(tm.end, quiet)
         if sim.steps == 0 and not res.diag_time:

@@ -212,7 +212,7 @@ def load_scene(path) -> Scene:
 
 def scene_from_dict(data: Any) -> Scene:
     """Build a Scene from plain data, check types and values; raise SceneError."""
-    scene = _build(Scene, data, "scene")
+    scene = parse_into(Scene, data, "scene")
     validate(scene)
     return scene
 
@@ -238,7 +238,8 @@ def _as_float(value, key):
     raise SceneError(f"{key}: expected a number, got {value!r}")
 
 
-def _build(tp, value, key):
+def parse_into(tp, value, key):
+    """Build dataclass ``tp`` (or a typed value) from plain data; SceneError names the key."""
     origin = get_origin(tp)
     args = get_args(tp)
     if origin is None and dataclasses.is_dataclass(tp):
@@ -253,7 +254,7 @@ def _build(tp, value, key):
         kwargs = {}
         for name, f in fields.items():
             if name in value:
-                kwargs[name] = _build(hints[name], value[name], f"{key}.{name}")
+                kwargs[name] = parse_into(hints[name], value[name], f"{key}.{name}")
             elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise SceneError(f"{key}.{name}: required key is missing")
         return tp(**kwargs)
@@ -263,17 +264,21 @@ def _build(tp, value, key):
         if value is None or value is False:
             return None
         inner = [a for a in args if a is not type(None)][0]
-        return _build(inner, value, key)
+        return parse_into(inner, value, key)
     if origin is tuple:
         if not isinstance(value, (list, tuple)) or len(value) != len(args):
             raise SceneError(f"{key}: expected a list of {len(args)} numbers, got {value!r}")
-        return tuple(_build(a, v, f"{key}[{i}]") for i, (a, v) in enumerate(zip(args, value)))
+        return tuple(parse_into(a, v, f"{key}[{i}]") for i, (a, v) in enumerate(zip(args, value)))
     if origin is list:
         if not isinstance(value, list):
             raise SceneError(f"{key}: expected a list, got {value!r}")
-        return [_build(args[0], v, f"{key}[{i}]") for i, v in enumerate(value)]
+        return [parse_into(args[0], v, f"{key}[{i}]") for i, v in enumerate(value)]
     if tp is float:
         return _as_float(value, key)
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
+            raise SceneError(f"{key}: expected an integer, got {value!r}")
+        return int(value)
     if tp is bool:
         if not isinstance(value, bool):
             raise SceneError(f"{key}: expected true or false, got {value!r}")

@@ -13,7 +13,8 @@ from . import boundary, cells, forces, guards, integrate, shifting
 from .build import Particles, build_particles
 from .scene import Scene
 
-_SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "pid")
+_SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "wnx", "wnz",
+           "pid")
 
 
 def default_domain(scene: Scene) -> tuple[float, float, float, float]:
@@ -52,6 +53,11 @@ class Simulation:
         self.rho, self.mass = p.rho.copy(), p.mass.copy()
         self.kind, self.wall, self.pid = p.kind.copy(), p.wall.copy(), p.pid.copy()
         self.gx, self.gz = p.gx.copy(), p.gz.copy()
+        # inward wall normal of each boundary particle (towards its ghost node)
+        gdx, gdz = np.nan_to_num(p.gx - p.x), np.nan_to_num(p.gz - p.z)
+        norm = np.hypot(gdx, gdz)
+        safe = np.where(norm > 0, norm, 1.0)
+        self.wnx, self.wnz = np.where(norm > 0, gdx / safe, 0.0), np.where(norm > 0, gdz / safe, 0.0)
         self.drho_prev = np.zeros(self.n)
         self.n_fluid = int((self.kind == 0).sum())
 
@@ -133,9 +139,9 @@ class Simulation:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
         self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
-                       self.start, g.ncx, g.ncz, g.periodic, g.period, self.split, self.h,
+                       self.wnx, self.wnz, self.start, g.ncx, g.ncz, g.periodic, g.period, self.split, self.h,
                        self.nu, self.h * self.c0, self.rho0, self.rho0 * s.gravity[1] / self.B,
-                       self.delta, self.acc, self.vmax_t)
+                       self.delta, s.dp * s.dp, self.acc, self.vmax_t)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, s.gravity[0], s.gravity[1],
                                                self.out, self.nq)
         self.vmax = float(self.vmax_t.max())
@@ -148,13 +154,13 @@ class Simulation:
     def _shift(self, dt: float):
         sh, g = self.scene.physics.shifting, self.grid
         A = self.scene.shifting_coefficient
-        gcx, gcz, divr = self.out[3], self.out[4], self.out[5]
+        gcx, gcz, divr, wnx, wnz = self.out[3], self.out[4], self.out[5], self.out[6], self.out[7]
         if self.shift_method == "skillen":
-            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, self.n_active, A,
+            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.n_active, A,
                                    self.h, dt, sh.surface_threshold, sh.max_shift * self.scene.dp,
                                    self.shift_dx, self.shift_dz)
         else:
-            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, divr, self.start, self.n_active,
+            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, divr, wnx, wnz, self.start, self.n_active,
                                 g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0, g.csx, g.csz,
                                 0.5 * A * self.h * self.h, self.h, sh.surface_threshold,
                                 self.shift_dx, self.shift_dz)
@@ -208,6 +214,19 @@ class Simulation:
                             self.rho0, self.walls, g.periodic, g.x0, g.period, self.health)
         return self.health
 
+    # ---- checkpoint -------------------------------------------------------------------
+    _STATE = _SORTED + ("t", "steps", "info", "dt_first", "n_active", "reason")
+
+    def state(self) -> dict:
+        """Everything needed to resume exactly where this simulation stands."""
+        return {k: (v.copy() if isinstance(v, np.ndarray) else v)
+                for k, v in ((k, getattr(self, k)) for k in self._STATE)}
+
+    def restore(self, state: dict) -> None:
+        for k in self._STATE:
+            v = state[k]
+            setattr(self, k, v.copy() if isinstance(v, np.ndarray) else v)
+
     # ---- for tests and tools -------------------------------------------------------
     def derivatives(self) -> dict[str, np.ndarray]:
         """Evaluate at the current state; ax, az, drho (and gradC_x, gradC_z, div_r with
@@ -215,7 +234,7 @@ class Simulation:
         reason = self._evaluate(self.t)
         if reason:
             raise RuntimeError(reason)
-        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r")[:self.nq]
+        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r", "wall_nx", "wall_nz")[:self.nq]
         inv = self._inverse_order()
         return {k: self.out[q][inv].copy() for q, k in enumerate(names)}
 

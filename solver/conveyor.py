@@ -1,0 +1,233 @@
+"""The conveyor-belt flow-front case (SPEC sections 1-2): physical numbers -> Scene + probes.
+
+Lab frame, x downslope along the belt, z bed-normal, gravity g (sin theta, -cos theta).
+The belt is the bottom wall z < 0, fixed particles carrying the velocity -u_b (upslope),
+ramped from 0 after a rest; a fixed wall closes the upstream end at x = 0. The fluid starts
+as a block of depth h_n and length ``fluid_length`` h_n, or with the lubrication front
+shape of the same area. The toe stands still in the lab frame at steady state.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import yaml
+
+from . import lubrication
+from .scene import Scene, SceneError, parse_into, scene_from_dict
+from .steady import SteadyCriteria
+
+START_SHAPES = ("block", "lubrication")
+
+
+@dataclass
+class Probes:
+    interval: float = 0.02  # s of simulated time between probe samples
+    stations: list[float] = field(default_factory=lambda: [0.76, 1.5, 9.7])  # x* upslope of toe
+    x_star_max: float = 14.0  # free-surface grid from the toe up to this x*
+    x_star_step: float = 0.1
+    z_star_step: float = 0.025  # velocity-profile grid z / h_n from 0 to z_star_max
+    z_star_max: float = 1.3
+    uniform_zone: tuple[float, float] = (9.0, 12.0)  # x* range of the uniform depth
+
+
+@dataclass
+class Steady:
+    window: float = 1.0  # s: trailing window the drift tolerances apply to
+    front_velocity: float = 0.01  # |toe velocity| / u_b
+    depth: float = 0.005  # uniform-depth change over the window / h_n
+    velocity: float = 0.02  # station depth-mean u* change over the window
+    average: float = 2.0  # s: averaging window once steady
+    max_time: float = 30.0  # s: give up (status not_steady) after this
+    min_time: float = 0.5  # s after the end of the belt ramp before steadiness counts
+
+
+@dataclass
+class Belt:
+    speed: float = 0.075  # u_b [m/s], belt moves upslope
+    rest: float = 0.05  # s at rest before the ramp
+    ramp: float = 0.25  # s to reach full speed
+    margin: float = 8.0  # belt length downstream of the initial toe, in h_n
+
+
+@dataclass
+class ConveyorCase:
+    dp: float
+    name: str = "conveyor"
+    ch: float = 1.8
+    shifting: str = "lind"
+    shifting_coefficient: float | None = None
+    density: float = 1383.0
+    viscosity: float = 5.6
+    slope_deg: float = 15.3
+    gravity: float = 9.81
+    belt: Belt = field(default_factory=Belt)
+    fluid_length: float = 20.0  # in h_n, of the initial block (the lubrication start keeps its area)
+    start: str = "lubrication"
+    wall_height: float = 2.5  # upstream wall, in h_n
+    normalising_depth: float = 0.0186  # m: the paper's h_n used to normalise its data
+    coefsound: float = 10.0
+    cfl: float = 0.2
+    density_diffusion: float | None = 0.1
+    boundary: str = "mdbc"
+    mdbc_velocity: str = "shepard"
+    max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
+    probes: Probes = field(default_factory=Probes)
+    steady: Steady = field(default_factory=Steady)
+    checkpoint_interval: float = 1.0  # s of simulated time
+    memory_budget_gb: float = 4.0
+
+    @property
+    def theta(self) -> float:
+        return math.radians(self.slope_deg)
+
+    @property
+    def h_n(self) -> float:
+        """Normal depth from the flux balance, eq. 13b."""
+        return lubrication.normal_depth(self.viscosity, self.belt.speed, self.density,
+                                        self.gravity, self.theta)
+
+    @property
+    def ramp_end(self) -> float:
+        return self.belt.rest + self.belt.ramp
+
+    def criteria(self) -> SteadyCriteria:
+        s = self.steady
+        return SteadyCriteria(window=s.window, front_velocity=s.front_velocity, depth=s.depth,
+                              velocity=s.velocity, min_time=self.ramp_end + s.min_time)
+
+    def to_dict(self) -> dict:
+        from dataclasses import asdict
+        from .scene import _plain
+        return _plain(asdict(self))
+
+    def to_yaml(self) -> str:
+        return yaml.safe_dump(self.to_dict(), sort_keys=False)
+
+
+def load_case(path) -> ConveyorCase:
+    with open(path) as fh:
+        try:
+            data = yaml.safe_load(fh)
+        except yaml.YAMLError as exc:
+            raise SceneError(f"{path}: not valid YAML: {exc}") from None
+    return case_from_dict(data)
+
+
+def case_from_dict(data) -> ConveyorCase:
+    case = parse_into(ConveyorCase, data, "case")
+    validate_case(case)
+    return case
+
+
+def validate_case(c: ConveyorCase) -> None:
+    """Case-level checks; the generated scene is validated by the scene rules too."""
+    def positive(v, key):
+        if not (v > 0 and math.isfinite(v)):
+            raise SceneError(f"{key}: must be a positive finite number, got {v!r}")
+
+    for key in ("dp", "density", "viscosity", "gravity", "fluid_length", "wall_height",
+                "normalising_depth", "coefsound", "cfl", "max_area_drift", "checkpoint_interval"):
+        positive(getattr(c, key), f"case.{key}")
+    if not 0 < c.slope_deg < 90:
+        raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
+    if c.start not in START_SHAPES:
+        raise SceneError(f"case.start: {c.start!r} is not one of {', '.join(START_SHAPES)}")
+    positive(c.belt.speed, "case.belt.speed")
+    positive(c.belt.margin, "case.belt.margin")
+    if c.belt.rest < 0 or c.belt.ramp < 0:
+        raise SceneError("case.belt.rest, case.belt.ramp: must be >= 0")
+    p = c.probes
+    for key in ("interval", "x_star_max", "x_star_step", "z_star_step", "z_star_max"):
+        positive(getattr(p, key), f"case.probes.{key}")
+    if not p.stations or min(p.stations) <= 0:
+        raise SceneError("case.probes.stations: need at least one station, all x* > 0")
+    if not 0 < p.uniform_zone[0] < p.uniform_zone[1]:
+        raise SceneError(f"case.probes.uniform_zone: need 0 < lower < upper, got {list(p.uniform_zone)}")
+    if p.uniform_zone[1] > p.x_star_max or max(p.stations) > p.x_star_max:
+        raise SceneError("case.probes.x_star_max: must cover the uniform zone and every station")
+    reach = c.fluid_length - 2.0  # keep the upstream wall region out of the probes
+    if p.x_star_max > reach:
+        raise SceneError(
+            f"case.fluid_length: {c.fluid_length:g} h_n leaves no room for probes up to "
+            f"x* = {p.x_star_max:g} (need fluid_length >= x_star_max + 2)")
+    s = c.steady
+    for key in ("window", "front_velocity", "depth", "velocity", "average", "max_time"):
+        positive(getattr(s, key), f"case.steady.{key}")
+    if s.min_time < 0:
+        raise SceneError("case.steady.min_time: must be >= 0")
+    if s.window < 5 * p.interval:
+        raise SceneError("case.steady.window: must hold at least 5 probe intervals")
+    if s.average < 1.0:
+        raise SceneError("case.steady.average: must be at least 1 s (the front velocity is "
+                         "averaged over one second)")
+    scene_from_dict(build_scene_dict(c))  # scene-level checks (budget, keys, geometry)
+
+
+def wall_thickness(c: ConveyorCase) -> float:
+    """Whole number of dp covering the kernel support 2h."""
+    return math.ceil(2.0 * c.ch - 1e-9) * c.dp
+
+
+def initial_toe(c: ConveyorCase) -> float:
+    """x of the toe at t = 0."""
+    hn = c.h_n
+    if c.start == "block":
+        return c.fluid_length * hn
+    return (c.fluid_length + lubrication.front_area_deficit(c.theta)) * hn
+
+
+def front_surface(c: ConveyorCase, n: int = 600) -> list[list[float]]:
+    """Points of the lubrication front surface from the wall (x = 0) to the toe, with the
+    area of a block of length fluid_length h_n at depth h_n."""
+    hn, x_toe = c.h_n, initial_toe(c)
+    eta = np.concatenate([np.linspace(0.0, 0.99, n // 2, endpoint=False),
+                          1 - np.geomspace(0.01, 1e-9, n // 2)])
+    xi = lubrication.xi_star(eta, c.theta) * hn
+    x = x_toe - xi
+    keep = x > 0
+    x, z = x[keep][::-1], (eta * hn)[keep][::-1]
+    x = np.concatenate([[0.0], x])
+    z = np.concatenate([[hn * lubrication.front_eta(x_toe / hn, c.theta)], z])
+    return [[float(a), float(b)] for a, b in zip(x, z)]
+
+
+def build_scene_dict(c: ConveyorCase) -> dict:
+    """The generic scene of SPEC section 2 as plain data."""
+    hn, th, g = c.h_n, c.theta, c.gravity
+    T = wall_thickness(c)
+    x_toe = initial_toe(c)
+    belt_end = c.dp * math.ceil((x_toe + c.belt.margin * hn) / c.dp)
+    wall_top = c.dp * math.ceil(c.wall_height * hn / c.dp)
+    if c.start == "block":
+        fluid = {"blocks": [{"x": [0.0, x_toe], "z": [0.0, hn]}]}
+    else:
+        fluid = {"profiles": [{"x": [0.0, c.dp * math.floor(x_toe / c.dp)], "base": 0.0,
+                               "surface": front_surface(c)}]}
+    shifting = {"method": c.shifting}
+    if c.shifting_coefficient is not None:
+        shifting["coefficient"] = c.shifting_coefficient
+    return {
+        "name": c.name,
+        "dp": c.dp, "ch": c.ch,
+        "fluid": {"density": c.density, "viscosity": c.viscosity, **fluid},
+        "walls": [
+            {"name": "belt", "x": [0.0, belt_end], "z": [-T, 0.0],
+             "velocity": [-c.belt.speed, 0.0], "moving": False,
+             "ramp_time": c.belt.ramp, "ramp_delay": c.belt.rest},
+            {"name": "upstream", "x": [-T, 0.0], "z": [-T, wall_top]},
+        ],
+        "gravity": [g * math.sin(th), -g * math.cos(th)],
+        "sound": {"coefsound": c.coefsound, "depth": hn},
+        "cfl": c.cfl,
+        "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
+                    "density_diffusion": c.density_diffusion, "shifting": shifting},
+        "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
+                 "diagnostics_interval": max(c.probes.interval, 0.01)},
+        "memory_budget_gb": c.memory_budget_gb,
+    }
+
+
+def build_scene(c: ConveyorCase) -> Scene:
+    return scene_from_dict(build_scene_dict(c))

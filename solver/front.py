@@ -1,0 +1,246 @@
+"""Run the conveyor-belt case: probes at an interval, steady-state stop, averaging,
+volume-consistency guard, checkpoints, and one NetCDF per run."""
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import pickle
+import tempfile
+
+import numpy as np
+import xarray as xr
+
+from . import steady
+from .conveyor import ConveyorCase, build_scene
+from .output import to_dataset, versions, write_atomic
+from .probes import C_SURFACE, FieldSampler, toe_position
+from .run import Runner
+from .simulation import Simulation
+
+SERIES = ("toe", "uniform_depth", "enclosed_area", "mass_area", "number_density")
+
+
+class FrontMonitor:
+    """Samples the probes every ``case.probes.interval``; detects steady state, then ends
+    the run after the averaging window. Fires the area-drift guard."""
+
+    def __init__(self, case: ConveyorCase):
+        self.case = case
+        self.interval = case.probes.interval
+        p = case.probes
+        self.x_star = np.round(np.arange(0.0, p.x_star_max + 0.5 * p.x_star_step, p.x_star_step), 10)
+        self.z_star = np.round(np.arange(0.0, p.z_star_max + 0.5 * p.z_star_step, p.z_star_step), 10)
+        self.stations = np.asarray(p.stations, dtype=float)
+        self.crit = case.criteria()
+        self.t: list[float] = []
+        self.series = {k: [] for k in SERIES}
+        self.surface: list[np.ndarray] = []  # z_max over x_star
+        self.velocity: list[np.ndarray] = []  # u* over (station, z_star)
+        self.t_steady = math.nan
+
+    # ---- one sample ---------------------------------------------------------------
+    def sample(self, sim: Simulation) -> dict:
+        c, hn, ub = self.case, self.case.h_n, self.case.belt.speed
+        dp = sim.scene.dp
+        n = sim.n_active
+        fl = sim.kind[:n] == 0
+        xf = sim.x[:n][fl]
+        toe = toe_position(xf, dp)
+        fs = FieldSampler(sim)
+        xs = np.arange(0.25 * dp, toe, 0.5 * dp)
+        zs = fs.surface(xs, 0.0)
+        enclosed = float(np.trapezoid(np.concatenate([[zs[0]], zs, [0.0]]),
+                                      np.concatenate([[0.0], xs, [toe]])))
+        mass_area = float((sim.mass[:n][fl] / sim.rho[:n][fl]).sum())
+        x_lab = toe - self.x_star * hn
+        surface = np.interp(x_lab, xs, zs, left=np.nan, right=0.0)
+        lo, hi = c.probes.uniform_zone
+        zone = (self.x_star >= lo) & (self.x_star <= hi)
+        depth = float(np.nanmean(surface[zone])) if np.isfinite(surface[zone]).any() else math.nan
+        # velocity lines at the stations
+        px = np.repeat(toe - self.stations * hn, self.z_star.size)
+        pz = np.tile(self.z_star * hn, self.stations.size)
+        out = fs.points(px, pz)
+        inside = out[0] >= C_SURFACE
+        u_star = np.where(inside, (out[2] + ub) / ub, np.nan).reshape(self.stations.size, -1)
+        # interior number density in the uniform zone: mid-depth points
+        zx = toe - np.linspace(lo, hi, 7) * hn
+        nd = fs.points(np.repeat(zx, 3), np.tile(np.array([0.3, 0.45, 0.6]) * depth, zx.size))
+        number_density = float(np.mean(nd[4]) * dp * dp) if np.isfinite(depth) else math.nan
+        return {"toe": toe, "uniform_depth": depth, "enclosed_area": enclosed,
+                "mass_area": mass_area, "number_density": number_density,
+                "surface": surface, "velocity": u_star}
+
+    def station_means(self) -> np.ndarray:
+        """Depth-mean u* of each station over time, (time, station)."""
+        v = np.asarray(self.velocity)
+        with np.errstate(all="ignore"):
+            return np.nanmean(v, axis=2)
+
+    # ---- monitor protocol ------------------------------------------------------------
+    def __call__(self, sim: Simulation):
+        s = self.sample(sim)
+        self.t.append(sim.t)
+        for k in SERIES:
+            self.series[k].append(s[k])
+        self.surface.append(s["surface"])
+        self.velocity.append(s["velocity"])
+        drift = s["enclosed_area"] / s["mass_area"] - 1.0
+        if abs(drift) > self.case.max_area_drift:
+            return ("diverged", f"t = {sim.t:.6g} s: enclosed area differs from the mass-implied "
+                    f"area by {100 * drift:+.1f} % (max_area_drift = {self.case.max_area_drift:g})")
+        c = self.case
+        if math.isnan(self.t_steady):
+            if steady.is_steady(self.t, self.series["toe"], self.series["uniform_depth"],
+                                self.station_means(), self.crit, c.belt.speed, c.h_n):
+                self.t_steady = sim.t
+        elif sim.t >= self.t_steady + c.steady.average - 1e-9:
+            return ("completed", "")
+        return None
+
+    # ---- results ---------------------------------------------------------------------
+    def dataset(self) -> xr.Dataset:
+        c = self.case
+        t = np.asarray(self.t)
+        hn = c.h_n
+        data = {
+            "toe_position": (("time",), np.asarray(self.series["toe"]),
+                             {"units": "m", "long_name": "toe (downstream end of the fluid), lab frame"}),
+            "uniform_depth": (("time",), np.asarray(self.series["uniform_depth"]),
+                              {"units": "m", "long_name": "mean free-surface elevation over the uniform zone"}),
+            "enclosed_area": (("time",), np.asarray(self.series["enclosed_area"]),
+                              {"units": "m2", "long_name": "area between bed and free surface, wall to toe"}),
+            "mass_area": (("time",), np.asarray(self.series["mass_area"]),
+                          {"units": "m2", "long_name": "mass-implied area sum m/rho"}),
+            "number_density": (("time",), np.asarray(self.series["number_density"]),
+                               {"units": "1", "long_name": "interior kernel number density sum W dp^2"}),
+            "surface_elevation": (("time", "x_star"), np.asarray(self.surface).reshape(t.size, -1),
+                                  {"units": "m", "long_name": "free surface z_max (C = 0.5 level)"}),
+            "velocity_star": (("time", "station", "z_star"),
+                              np.asarray(self.velocity).reshape(t.size, self.stations.size, -1),
+                              {"units": "1", "long_name": "(u + u_b) / u_b, belt frame, Shepard interpolated"}),
+        }
+        ds = xr.Dataset(data, coords={
+            "time": ("time", t, {"units": "s", "long_name": "probe time"}),
+            "x_star": ("x_star", self.x_star, {"units": "1", "long_name": "distance upslope from the toe / h_n"}),
+            "station": ("station", self.stations, {"units": "1", "long_name": "station x* upslope from the toe"}),
+            "z_star": ("z_star", self.z_star, {"units": "1", "long_name": "bed-normal height / h_n"}),
+        })
+        ds["area_drift"] = (("time",), ds.enclosed_area.values / ds.mass_area.values - 1.0,
+                            {"units": "1", "long_name": "enclosed / mass-implied area - 1"})
+        steady_found = np.isfinite(self.t_steady)
+        ds.attrs["steady_state_time_s"] = float(self.t_steady)
+        if steady_found:
+            win = (t >= self.t_steady - 1e-9) & (t <= self.t_steady + c.steady.average + 1e-9)
+            tw = t[win]
+            avg = ds.isel(time=win).mean("time")
+            for k in ("surface_elevation", "velocity_star", "uniform_depth", "number_density", "area_drift"):
+                ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name="steady-window mean of " + ds[k].attrs["long_name"])
+            d = steady.drifts(tw, ds.toe_position.values[win], ds.uniform_depth.values[win],
+                              self.station_means()[win], tw[-1] - tw[0])
+            last_second = tw >= tw[-1] - 1.0 - 1e-9
+            ds["front_velocity"] = ((), steady.trend(tw[last_second], ds.toe_position.values[win][last_second]),
+                                    {"units": "m s-1", "long_name": "toe velocity over the last second of the window, lab frame"})
+            ds.attrs["average_window_s"] = float(tw[-1] - tw[0])
+            ds.attrs["window_front_velocity_over_ub"] = float(d["front_velocity"] / c.belt.speed)
+            ds.attrs["window_depth_change_over_hn"] = float(d["depth_change"] / hn)
+            ds.attrs["window_velocity_change"] = float(d["velocity_change"])
+        return ds
+
+
+def case_hash(case: ConveyorCase) -> str:
+    return hashlib.sha256(case.to_yaml().encode()).hexdigest()[:16]
+
+
+class Checkpointer:
+    """Pickles the runner state every ``interval`` of simulated time, atomically."""
+
+    def __init__(self, path, interval: float, key: str):
+        self.path, self.interval, self.key = os.fspath(path), interval, key
+        self.next = None
+
+    def __call__(self, runner: Runner):
+        if self.next is None:
+            self.next = runner.sim.t + self.interval
+        if runner.sim.t >= self.next - 1e-12:
+            self.save(runner)
+            self.next += self.interval
+
+    def save(self, runner: Runner):
+        state = {"key": self.key, "sim": runner.sim.state(), "res": runner.res,
+                 "next_out": runner.next_out, "next_diag": runner.next_diag,
+                 "next_monitor": runner.next_monitor, "monitors": runner.monitors,
+                 "next_checkpoint": self.next + self.interval, "wall_time": runner.elapsed()}
+        folder = os.path.dirname(os.path.abspath(self.path))
+        os.makedirs(folder, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=os.path.basename(self.path) + ".", suffix=".tmp", dir=folder)
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump(state, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, self.path)
+
+    def restore(self, runner: Runner) -> bool:
+        """Load a matching checkpoint into the runner; False if none (or another case's)."""
+        if not os.path.exists(self.path):
+            return False
+        try:
+            with open(self.path, "rb") as fh:
+                state = pickle.load(fh)
+        except Exception:
+            return False
+        if state.get("key") != self.key:
+            return False
+        runner.sim.restore(state["sim"])
+        runner.res = state["res"]
+        runner.res.wall_time = state["wall_time"]
+        runner.next_out, runner.next_diag = state["next_out"], state["next_diag"]
+        runner.next_monitor, runner.monitors = state["next_monitor"], state["monitors"]
+        self.next = state["next_checkpoint"]
+        return True
+
+    def remove(self):
+        if os.path.exists(self.path):
+            os.remove(self.path)
+
+
+def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dataset:
+    """Run the case to steady state (or max_time) and return its dataset.
+
+    With ``checkpoint`` (a path), the run resumes from a matching checkpoint there and
+    writes one every ``case.checkpoint_interval`` seconds of simulated time; the file is
+    removed when the run ends.
+    """
+    scene = build_scene(case)
+    monitor = FrontMonitor(case)
+    runner = Runner(scene, Simulation(scene), monitors=[monitor], final_snapshot=True)
+    ckpt = None
+    resumed = False
+    if checkpoint is not None:
+        ckpt = Checkpointer(checkpoint, case.checkpoint_interval, case_hash(case))
+        resumed = ckpt.restore(runner)
+        monitor = runner.monitors[0]
+    res = runner.run(quiet=quiet, on_step=ckpt)
+    if res.status == "completed" and math.isnan(monitor.t_steady):
+        res.status = "not_steady"
+        res.reason = f"no steady state by max_time = {case.steady.max_time:g} s"
+    run_ds = to_dataset(res)
+    # keep only the final snapshot (the particle distribution of the paper's Fig. 7)
+    if "snapshot" in run_ds.dims and run_ds.sizes["snapshot"] > 1:
+        run_ds = run_ds.isel(snapshot=[-1])
+    run_ds = run_ds.rename({"time": "diag_time"})
+    ds = xr.merge([monitor.dataset(), run_ds], combine_attrs="override")
+    ds.attrs.update(run_ds.attrs)
+    ds.attrs.update({
+        "title": f"sph-surge conveyor-belt front, case '{case.name}'",
+        "h_n_m": case.h_n, "normalising_depth_m": case.normalising_depth, "belt_speed_m_s": case.belt.speed,
+        "slope_deg": case.slope_deg, "ch": case.ch, "shifting": case.shifting,
+        "simulated_time_s": float(runner.sim.t), "resumed_from_checkpoint": int(resumed),
+        "case_yaml": case.to_yaml(),
+        "n_fluid": int(runner.sim.n_fluid), "n_boundary": int(runner.sim.n - runner.sim.n_fluid),
+    })
+    if ckpt is not None:
+        ckpt.remove()
+    return ds
+
+
+__all__ = ["FrontMonitor", "run_front", "versions", "write_atomic"]
