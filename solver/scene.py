@@ -116,6 +116,7 @@ class Shifting:
     coefficient: float | None = None  # A (skillen, default 2) or A_L (lind, default 1)
     surface_threshold: float = 1.5  # div r below this marks the free surface
     max_shift: float = 0.1  # skillen: clip of each component, in units of dp
+    density_correction: bool = True  # rho *= 1 - div(dr): shifting keeps volume and density consistent
 
 
 @dataclass

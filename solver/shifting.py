@@ -4,9 +4,16 @@ skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - th
          up to div r = 2, each component clipped to max_shift dp.
 lind:    dr = -D gradC, D = A_L h^2 / 2; no shift for particles within 2h of a free-surface
          particle (div r < thr).
-Near a wall (n = normalised kernel-weighted sum of the inward normals of the wall particles
-in reach) the component of dr pointing into the wall is removed: shifting redistributes
-particles along a wall and away from it, never through it.
+Density correction (on by default): shifting moves particles relative to the fluid, so each
+particle's volume changes by V div(dr); with its mass fixed its density becomes
+rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab. Without it, shifting that
+spreads particles near a free surface inflates the fluid at constant density (measured on
+the periodic film: +2.1 % area in 1 s with skillen, +0.17 %/s with lind; with it +0.3 %
+and -0.06 %).
+Near a wall (n = kernel-weighted sum sum_b -F_ab n_b of the inward normals of the wall
+particles in reach) the component of dr pointing into the wall is removed once the particle
+is as close as the lattice puts it (|n| at least its value dp/2 from a flat wall): shifting
+redistributes particles along a wall and away from it, never through it.
 """
 from __future__ import annotations
 
@@ -16,11 +23,25 @@ import numba as nb
 import numpy as np
 
 
+def wall_proximity_at_half_dp(h: float, dp: float) -> float:
+    """|sum_b -F(r_ab) n_b| for a particle dp/2 from a flat wall of lattice particles: the
+    wall-normal sum of a fluid particle sitting where the lattice puts it."""
+    alpha = 7.0 / (4.0 * math.pi * h * h)
+    fac = -5.0 * alpha / (h * h)
+    n = int(math.ceil(2 * h / dp)) + 1
+    i = np.arange(-n, n + 1)
+    X, K = np.meshgrid(i * dp, (np.arange(n) + 0.5) * dp + 0.5 * dp)
+    r = np.hypot(X, K)
+    q = np.clip(r / h, 0.0, 2.0)
+    return float((-fac * (1 - 0.5 * q) ** 3).sum())
+
+
 @nb.njit(inline="always", cache=True)
-def _off_wall(dx, dz, nx, nz):
-    """Remove the part of (dx, dz) along -n (into the wall) when n is non-zero."""
+def _off_wall(dx, dz, nx, nz, s0):
+    """Remove the part of (dx, dz) along -n (into the wall) when the particle is at least as
+    close to the wall as the lattice puts it (|n| >= s0)."""
     nn = math.sqrt(nx * nx + nz * nz)
-    if nn > 0.0:
+    if nn >= s0 and nn > 0.0:
         nx /= nn
         nz /= nn
         d = dx * nx + dz * nz
@@ -31,7 +52,7 @@ def _off_wall(dx, dz, nx, nz):
 
 
 @nb.njit(parallel=True, cache=True)
-def skillen_shift(kind, u, w, gcx, gcz, divr, wnx, wnz, n_active, A, h, dt, thr, clip, dx_out, dz_out):
+def skillen_shift(kind, u, w, gcx, gcz, divr, wnx, wnz, s0, n_active, A, h, dt, thr, clip, dx_out, dz_out):
     for i in nb.prange(n_active):
         dx_out[i] = 0.0
         dz_out[i] = 0.0
@@ -40,11 +61,11 @@ def skillen_shift(kind, u, w, gcx, gcz, divr, wnx, wnz, n_active, A, h, dt, thr,
         f = min((divr[i] - thr) / (2.0 - thr), 1.0)
         c = -A * h * math.sqrt(u[i] * u[i] + w[i] * w[i]) * dt * f
         dx_out[i], dz_out[i] = _off_wall(min(max(c * gcx[i], -clip), clip),
-                                         min(max(c * gcz[i], -clip), clip), wnx[i], wnz[i])
+                                         min(max(c * gcz[i], -clip), clip), wnx[i], wnz[i], s0)
 
 
 @nb.njit(parallel=True, cache=True)
-def lind_shift(x, z, kind, gcx, gcz, divr, wnx, wnz, start, n_active, ncx, ncz, periodic, period,
+def lind_shift(x, z, kind, gcx, gcz, divr, wnx, wnz, s0, start, n_active, ncx, ncz, periodic, period,
                x0, z0, csx, csz, D, h, thr, dx_out, dz_out):
     four_h2 = 4.0 * h * h
     for i in nb.prange(n_active):
@@ -86,4 +107,48 @@ def lind_shift(x, z, kind, gcx, gcz, divr, wnx, wnz, start, n_active, ncx, ncz, 
             if near_surface:
                 break
         if not near_surface:
-            dx_out[i], dz_out[i] = _off_wall(-D * gcx[i], -D * gcz[i], wnx[i], wnz[i])
+            dx_out[i], dz_out[i] = _off_wall(-D * gcx[i], -D * gcz[i], wnx[i], wnz[i], s0)
+
+
+@nb.njit(parallel=True, cache=True)
+def shift_divergence(x, z, kind, mass, rho, sdx, sdz, start, n_active, ncx, ncz, periodic,
+                     period, x0, z0, csx, csz, h, out):
+    """out[a] = div(dr)_a = sum_b V_b (dr_b - dr_a) . gradW_ab over all neighbours (walls
+    have dr = 0), for fluid particles."""
+    alpha = 7.0 / (4.0 * math.pi * h * h)
+    fac = -5.0 * alpha / (h * h)
+    four_h2 = 4.0 * h * h
+    for i in nb.prange(n_active):
+        out[i] = 0.0
+        if kind[i] != 0:
+            continue
+        ix = int(math.floor((x[i] - x0) / csx))
+        iz = int(math.floor((z[i] - z0) / csz))
+        s = 0.0
+        for ddx in range(-1, 2):
+            jx = ix + ddx
+            shift = 0.0
+            if jx < 0 or jx >= ncx:
+                if not periodic:
+                    continue
+                shift = -period if jx < 0 else period
+                jx = jx + ncx if jx < 0 else jx - ncx
+            for ddz in range(-1, 2):
+                jz = iz + ddz
+                if jz < 0 or jz >= ncz:
+                    continue
+                c = jx * ncz + jz
+                for j in range(start[c], start[c + 1]):
+                    if j == i:
+                        continue
+                    ex = x[i] - (x[j] + shift)
+                    ez = z[i] - z[j]
+                    r2 = ex * ex + ez * ez
+                    if r2 >= four_h2:
+                        continue
+                    s2 = 1.0 - 0.5 * math.sqrt(r2) / h
+                    F = fac * s2 * s2 * s2
+                    ddx_ = sdx[j] - sdx[i]
+                    ddz_ = sdz[j] - sdz[i]
+                    s += mass[j] / rho[j] * F * (ddx_ * ex + ddz_ * ez)
+        out[i] = s

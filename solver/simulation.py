@@ -88,6 +88,8 @@ class Simulation:
         self.p = np.zeros(self.n)
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
+        self.shift_div = np.zeros(self.n)
+        self.wall_s0 = shifting.wall_proximity_at_half_dp(self.h, s.dp)
         self._buf = {np.dtype(a.dtype): np.empty(self.n, a.dtype)
                      for a in (self.x, self.kind, self.wall, self.pid)}
         self.health = np.zeros(4)
@@ -156,14 +158,20 @@ class Simulation:
         A = self.scene.shifting_coefficient
         gcx, gcz, divr, wnx, wnz = self.out[3], self.out[4], self.out[5], self.out[6], self.out[7]
         if self.shift_method == "skillen":
-            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.n_active, A,
+            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.wall_s0, self.n_active, A,
                                    self.h, dt, sh.surface_threshold, sh.max_shift * self.scene.dp,
                                    self.shift_dx, self.shift_dz)
         else:
-            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, divr, wnx, wnz, self.start, self.n_active,
+            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, divr, wnx, wnz, self.wall_s0, self.start, self.n_active,
                                 g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0, g.csx, g.csz,
                                 0.5 * A * self.h * self.h, self.h, sh.surface_threshold,
                                 self.shift_dx, self.shift_dz)
+        if sh.density_correction:  # rho follows the volume change of the shift
+            shifting.shift_divergence(self.x, self.z, self.kind, self.mass, self.rho, self.shift_dx,
+                                      self.shift_dz, self.start, self.n_active, g.ncx, g.ncz,
+                                      g.periodic, g.period, g.x0, g.z0, g.csx, g.csz, self.h,
+                                      self.shift_div)
+            self.rho[:self.n_active] *= 1.0 - self.shift_div[:self.n_active]
         self.x[:self.n_active] += self.shift_dx[:self.n_active]
         self.z[:self.n_active] += self.shift_dz[:self.n_active]
 

@@ -49,7 +49,9 @@ def test_uniform_lattice_is_not_shifted(method):
 
 @pytest.mark.parametrize("method", ["skillen", "lind"])
 def test_shifting_reduces_disorder(method):
-    scene = moving_channel(method)
+    # shifting alone, without the density correction: with it, and no dynamics to relax the
+    # corrected densities, the iteration would chase a non-uniform volume field
+    scene = moving_channel(method, density_correction=False)
     parts = build_particles(scene)
     f = parts.kind == 0
     rng = np.random.default_rng(7)
@@ -77,3 +79,48 @@ def test_shifting_off_leaves_disorder():
     before = sim.snapshot()["x"]
     sim.derivatives()
     assert np.array_equal(sim.snapshot()["x"], before)
+
+
+def test_density_correction_follows_the_volume_change_of_the_shift():
+    """rho *= 1 - div(dr): zero for a uniform shift, -2 eps rho for dr = eps r in 2D."""
+    from solver import shifting
+    scene = example_scene("channel")
+    sim = Simulation(scene)
+    g, n = sim.grid, sim.n_active
+    fl = sim.kind[:n] == 0
+    H = scene.fluid.blocks[0].z[1]
+    interior = fl & (sim.z[:n] > 2 * sim.h) & (sim.z[:n] < H - 2 * sim.h)
+    out = np.zeros(sim.n)
+
+    def div(dx, dz):
+        shifting.shift_divergence(sim.x, sim.z, sim.kind, sim.mass, sim.rho, dx, dz, sim.start, n,
+                                  g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0, g.csx, g.csz,
+                                  sim.h, out)
+        return out[:n].copy()
+
+    uniform = np.where(sim.kind == 0, 0.01 * scene.dp, 0.0)
+    assert np.abs(div(uniform, uniform)[interior]).max() < 1e-12
+    eps = 1e-3
+    zc = 0.5 * H
+    d = div(np.zeros(sim.n), np.where(sim.kind == 0, eps * (sim.z - zc), 0.0))
+    np.testing.assert_allclose(d[interior], eps, rtol=0.01)  # d(dz)/dz = eps
+
+
+def film_inflation(method, correction, t_end=0.5):
+    """Relative growth of the film's free-surface height over t_end (periodic film)."""
+    from solver.probes import FieldSampler
+    scene = example_scene("film", physics={"shifting": {"method": method, "density_correction": correction}},
+                          time={"end": t_end, "output_interval": t_end})
+    sim = Simulation(scene)
+    xs = np.linspace(0.002, 0.017, 8)
+    z0 = FieldSampler(sim).surface(xs, 0.0).mean()
+    res = run_scene(scene, sim=sim)
+    assert res.status == "completed", res.reason
+    return FieldSampler(sim).surface(xs, 0.0).mean() / z0 - 1.0
+
+
+def test_skillen_without_density_correction_inflates_a_film_and_with_it_does_not():
+    """The known failure: shifting near a free surface spreads particles at constant density.
+    Measured here: +1.8 % in 0.5 s without the correction, +0.3 % with it."""
+    assert film_inflation("skillen", False) > 0.01
+    assert abs(film_inflation("skillen", True)) < 0.005

@@ -1,0 +1,101 @@
+"""The conveyor-belt case: preset geometry, and a killed run resumed from its checkpoint."""
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from solver import lubrication
+from solver.build import build_particles
+from solver.conveyor import build_scene, case_from_dict, initial_toe, wall_thickness
+from solver.scene import SceneError
+from tests.conftest import EXAMPLES
+
+
+def paper(**changes):
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        d = yaml.safe_load(fh)
+    d.update(changes)
+    return case_from_dict(d)
+
+
+def test_normal_depth_and_reference_stations():
+    c = paper()
+    assert c.h_n == pytest.approx(18.76e-3, abs=0.005e-3)
+    assert c.normalising_depth == 0.0186
+    eta = lubrication.front_eta(np.array([0.76, 1.5, 9.7]), c.theta)
+    np.testing.assert_allclose(eta, [0.7379, 0.8516, 0.99866], atol=5e-5)
+
+
+@pytest.mark.parametrize("start", ["block", "lubrication"])
+def test_preset_geometry(start):
+    c = paper(start=start, dp=2.0e-3, ch=1.5)
+    scene = build_scene(c)
+    g = scene.gravity
+    assert math.degrees(math.atan2(g[0], -g[1])) == pytest.approx(15.3)
+    assert math.hypot(*g) == pytest.approx(9.81)
+    belt, upstream = scene.walls
+    assert belt.velocity == (-0.075, 0.0) and not belt.moving
+    assert belt.ramp_delay == c.belt.rest and belt.ramp_time == c.belt.ramp
+    assert upstream.velocity == (0.0, 0.0) and upstream.x[1] == 0.0
+    assert belt.z[1] == 0.0 and wall_thickness(c) >= 2 * scene.h
+    assert belt.x[1] >= initial_toe(c) + c.belt.margin * c.h_n - 1e-12
+    p = build_particles(scene)
+    f = p.kind == 0
+    area = f.sum() * c.dp ** 2
+    # same fluid area for both starts: fluid_length h_n^2, to lattice rounding (half a dp per column)
+    assert area == pytest.approx(c.fluid_length * c.h_n ** 2, abs=0.5 * c.dp * initial_toe(c))
+    assert p.x[f].min() > 0 and p.z[f].min() > 0
+    assert p.x[f].max() < initial_toe(c)
+    if start == "block":
+        assert p.z[f].max() == pytest.approx(c.dp * (round(c.h_n / c.dp) - 0.5), abs=1e-12)
+
+
+def test_case_errors_name_the_key():
+    with pytest.raises(SceneError, match="case.start"):
+        paper(start="pyramid")
+    with pytest.raises(SceneError, match="case.probes.stations"):
+        paper(probes={"stations": []})
+    with pytest.raises(SceneError, match="case.fluid_length"):
+        paper(fluid_length=10.0)
+    with pytest.raises(SceneError, match="case: unknown key.*shiftng"):
+        paper(shiftng="lind")
+    with pytest.raises(SceneError, match="physics.shifting.method"):
+        paper(shifting="magic")
+
+
+def test_killed_run_resumes_to_the_same_result(tmp_path):
+    case = tmp_path / "case.yaml"
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        d = yaml.safe_load(fh)
+    d.update(dp=2.5e-3, ch=1.5, checkpoint_interval=0.1)
+    d["steady"].update(max_time=0.5, window=0.2)
+    d["probes"].update(interval=0.02)
+    case.write_text(yaml.safe_dump(d))
+    cmd = [sys.executable, "-m", "solver", "front", str(case), "--quiet"]
+    ref = tmp_path / "ref.nc"
+    assert subprocess.run(cmd + ["-o", str(ref), "--no-checkpoint"]).returncode == 3  # not steady
+    out = tmp_path / "out.nc"
+    ckpt = tmp_path / "out.nc.ckpt"
+    p = subprocess.Popen(cmd + ["-o", str(out)])
+    t0 = time.time()
+    while not ckpt.exists() and p.poll() is None and time.time() - t0 < 120:
+        time.sleep(0.005)
+    killed = p.poll() is None
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    assert killed, "the run ended before it could be killed"
+    assert ckpt.exists() and not out.exists()  # nothing that looks finished
+    assert subprocess.run(cmd + ["-o", str(out)]).returncode == 3
+    assert not ckpt.exists()
+    a, b = xr.open_dataset(ref), xr.open_dataset(out)
+    assert b.attrs["resumed_from_checkpoint"] == 1 and a.attrs["resumed_from_checkpoint"] == 0
+    assert a.attrs["steps"] == b.attrs["steps"]
+    for v in a.data_vars:
+        np.testing.assert_array_equal(a[v].values, b[v].values, err_msg=v)
