@@ -5,6 +5,7 @@ first-order corrected interpolation of the fluid density at g,
   [sum W V, sum (r_j - r_g) W V; sum gradW V, sum gradW (r_j - r_g)^T V] [rho_g; grad rho]
       = [sum rho_j W V; sum rho_j gradW V],
 (Shepard rho_g where the matrix is near-singular), extrapolated rho_b = rho_g + (r_b - r_g).grad rho
+when that is not below rho_g (the wall is never weaker than the fluid at its ghost node),
 and floored at rho0 (a wall pushes, never pulls: near a free surface the interpolation
 would otherwise give wall tension that draws fluid into the wall);
 no-slip velocity v_b = 2 v_wall - v_g with v_g the Shepard-interpolated fluid velocity
@@ -148,7 +149,10 @@ def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_act
             ddxg = x[i] - gx
             if periodic:  # nearest image
                 ddxg -= period * math.floor(ddxg / period + 0.5)
-            rb = rg + (ddxg * gdx + (z[i] - gz) * gdz) / h
+            # extrapolate only outward-increasing density: a pressure that falls into the
+            # wall (fluid pushed towards it) would leave the wall weaker than the fluid at
+            # its ghost node, and the fluid would walk through it
+            rb = max(rg + (ddxg * gdx + (z[i] - gz) * gdz) / h, rg)
         else:
             rb = b0 / a00
         if corrected_velocity and well_posed:

@@ -25,6 +25,10 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--no-checkpoint", action="store_true", help="never write or read a checkpoint")
     f.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a case key, e.g. --set dp=0.002 --set steady.max_time=5")
+    f.add_argument("--allow-diverged", action="store_true",
+                   help="exit 0 when a diverged or unsteady run was written (campaigns record it)")
+    w = sub.add_parser("warm", help="compile and cache every numba kernel (before parallel jobs)")
+    w.add_argument("--touch", default=None, help="file to create when done")
     return ap
 
 
@@ -32,6 +36,8 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     if args.command == "front":
         return _front(args)
+    if args.command == "warm":
+        return _warm(args)
     from .scene import SceneError, load_scene
     try:
         scene = load_scene(args.scene)
@@ -106,4 +112,32 @@ def _front(args) -> int:
     if ds.attrs["reason"]:
         msg += f" ({ds.attrs['reason']})"
     print(msg, file=sys.stderr)
-    return 0 if ds.attrs["status"] == "completed" else 3
+    return 0 if ds.attrs["status"] == "completed" or args.allow_diverged else 3
+
+
+def _warm(args) -> int:
+    """Step a tiny belt case with every shifting method, diffusion on and off, so that the
+    numba cache holds every kernel before parallel jobs start."""
+    import time
+    from .conveyor import build_scene, case_from_dict
+    from .front import FrontMonitor
+    from .simulation import Simulation
+    from .scene import scene_from_dict
+    tic = time.perf_counter()
+    for shifting in ("none", "skillen", "lind"):
+        for diffusion in (0.1, None):
+            case = case_from_dict({"dp": 0.004, "ch": 1.5, "shifting": shifting,
+                                   "density_diffusion": diffusion})
+            for boundary in ("mdbc", "dbc"):
+                d = build_scene(case).to_dict()
+                d["physics"]["boundary"] = boundary
+                sim = Simulation(scene_from_dict(d))
+                for _ in range(2):
+                    sim.step()
+            FrontMonitor(case)(sim)
+    print(f"numba kernels compiled and cached in {time.perf_counter() - tic:.1f} s", file=sys.stderr)
+    if args.touch:
+        from pathlib import Path
+        Path(args.touch).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.touch).touch()
+    return 0

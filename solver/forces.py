@@ -1,6 +1,10 @@
 """The pair loop (SPEC section 6): continuity with Fourtakas diffusion, pressure,
 Lo & Shao laminar viscosity, and the shifting sums, over a half stencil.
 
+Fluid-wall pairs never attract: their P_a + P_b is floored at zero. A fluid in suction next
+to a wall (negative gauge pressure, as in the corner of a belt running into a fixed wall)
+would otherwise be drawn through the wall by the symmetric pressure term.
+
 Each pair (a, b) is visited once and its contributions are added to both particles,
 into per-thread accumulators ``acc[t, q, i]`` (no write races), reduced afterwards.
 Quantities q: 0 ax, 1 az, 2 drho/dt, 3 gradC_x, 4 gradC_z, 5 div r, 6-7 the kernel-weighted
@@ -9,12 +13,14 @@ Density diffusion and the shifting sums are compiled in or out (``make_pair_loop
 
   drho_a/dt = rho_a sum_b u_ab.gradW_ab V_b + h c0 D_a
   D_a = 2 delta sum_b ((rho_a - rho_b) - rho_ab^H) (r_ab.gradW_ab) / (r^2 + eta^2) V_b
-  du_a/dt = -sum_b m_b (P_a + P_b)/(rho_a rho_b) gradW_ab
+  du_a/dt = -sum_b m_b (P_a + P_b)/(rho_a rho_b) gradW_ab   (P_a + P_b >= 0 for fluid-wall pairs)
             + sum_b m_b 4 nu (r_ab.gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)) u_ab  (+ g)
-  gradC_a = sum_b V_b gradW_ab,   div r_a = -sum_b V_b r_ab.gradW_ab
-In the two shifting sums a wall particle's volume is its lattice cell dp^2, not m/rho: the
-mDBC wall density follows the fluid pressure, and a wall that looked less concentrated
-than the fluid beside it would shift fluid into it, step after step.
+  gradC_a = sum_b dp^2 gradW_ab,  div r_a = -sum_b dp^2 r_ab.gradW_ab
+In the two shifting sums every particle's volume is its lattice cell dp^2, not m/rho, so the
+concentration measures particle number density, which is what shifting evens out. With m/rho,
+a wall whose mDBC density follows the fluid pressure looks less concentrated than the fluid
+beside it and draws fluid into it, and a particle compressed by shifting (density correction)
+looks smaller and draws its neighbours further onto it: both feed back step after step.
 """
 from __future__ import annotations
 
@@ -107,7 +113,10 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                                 acc[t, 2, a] += ra * udotg * Vb
                                 acc[t, 2, b] += rb * udotg * Va
                                 # pressure and laminar viscosity
-                                pt = (pa + p[b]) / (ra * rb) * F
+                                psum = pa + p[b]
+                                if ka + kb == 1 and psum < 0.0:
+                                    psum = 0.0  # a wall pushes, never pulls
+                                pt = psum / (ra * rb) * F
                                 vt = 4.0 * nu * rdotg / (ra + rb) * inv_r2e
                                 fx = -pt * dx + vt * du
                                 fz = -pt * dz + vt * dw
@@ -126,15 +135,15 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                                         acc[t, 2, a] += g * (drab - rho0 * fa) * Vb
                                         acc[t, 2, b] += g * (-drab - rho0 * fb) * Va
                                 if shifting:
-                                    # a wall particle counts with its lattice cell dp^2
-                                    Vsb = dp2 if kb == 1 else Vb
-                                    Vsa = dp2 if ka == 1 else Va
-                                    acc[t, 3, a] += Vsb * F * dx
-                                    acc[t, 4, a] += Vsb * F * dz
-                                    acc[t, 3, b] -= Vsa * F * dx
-                                    acc[t, 4, b] -= Vsa * F * dz
-                                    acc[t, 5, a] -= Vsb * rdotg
-                                    acc[t, 5, b] -= Vsa * rdotg
+                                    # concentration counts particles: volume dp^2 each
+                                    sx = dp2 * F * dx
+                                    sz = dp2 * F * dz
+                                    acc[t, 3, a] += sx
+                                    acc[t, 4, a] += sz
+                                    acc[t, 3, b] -= sx
+                                    acc[t, 4, b] -= sz
+                                    acc[t, 5, a] -= dp2 * rdotg
+                                    acc[t, 5, b] -= dp2 * rdotg
                                     if kb == 1:
                                         acc[t, 6, a] -= F * wnx[b]
                                         acc[t, 7, a] -= F * wnz[b]

@@ -2,8 +2,9 @@
 
 skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - thr)/(2 - thr)
          up to div r = 2, each component clipped to max_shift dp.
-lind:    dr = -D gradC, D = A_L h^2 / 2; no shift for particles within 2h of a free-surface
-         particle (div r < thr).
+lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp; no shift for
+         particles within 2h of a free-surface particle (div r < thr, or a scan-region test
+         where thr <= div r < 1.9, see free_surface).
 Density correction (on by default): shifting moves particles relative to the fluid, so each
 particle's volume changes by V div(dr); with its mass fixed its density becomes
 rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab. Without it, shifting that
@@ -64,14 +65,82 @@ def skillen_shift(kind, u, w, gcx, gcz, divr, wnx, wnz, s0, n_active, A, h, dt, 
                                          min(max(c * gcz[i], -clip), clip), wnx[i], wnz[i], s0)
 
 
+SCAN_UPPER = 1.9  # div r below this (and above the threshold): apply the scan-region test
+
+
 @nb.njit(parallel=True, cache=True)
-def lind_shift(x, z, kind, gcx, gcz, divr, wnx, wnz, s0, start, n_active, ncx, ncz, periodic, period,
-               x0, z0, csx, csz, D, h, thr, dx_out, dz_out):
+def free_surface(x, z, kind, gcx, gcz, divr, start, n_active, ncx, ncz, periodic, period,
+                 x0, z0, csx, csz, h, thr, upper, flag):
+    """flag[i] = 1 for free-surface fluid particles: div r < thr, or thr <= div r < upper and
+    the scan region of Marrone et al. (2010) is empty. With n = -gradC/|gradC| the outward
+    normal and T = r_i + h n, a neighbour j (fluid or wall) occupies it when
+    |r_j - r_i| >= sqrt(2) h and |r_j - T| < h, or |r_j - r_i| < sqrt(2) h and
+    |n.(r_j - T)| + |t.(r_j - T)| < h. This catches surfaces that a wall inside the kernel
+    hides from div r, such as the wedge of a front on the bed."""
+    four_h2 = 4.0 * h * h
+    two_h2 = 2.0 * h * h
+    for i in nb.prange(n_active):
+        flag[i] = 0
+        if kind[i] != 0:
+            continue
+        if divr[i] < thr:
+            flag[i] = 1
+            continue
+        if divr[i] >= upper:
+            continue
+        g = math.sqrt(gcx[i] * gcx[i] + gcz[i] * gcz[i])
+        if g == 0.0:
+            continue
+        nx, nz = -gcx[i] / g, -gcz[i] / g
+        tx, tz = x[i] + h * nx, z[i] + h * nz
+        ix = int(math.floor((x[i] - x0) / csx))
+        iz = int(math.floor((z[i] - z0) / csz))
+        occupied = False
+        for ddx in range(-1, 2):
+            jx = ix + ddx
+            shift = 0.0
+            if jx < 0 or jx >= ncx:
+                if not periodic:
+                    continue
+                shift = -period if jx < 0 else period
+                jx = jx + ncx if jx < 0 else jx - ncx
+            for ddz in range(-1, 2):
+                jz = iz + ddz
+                if jz < 0 or jz >= ncz:
+                    continue
+                c = jx * ncz + jz
+                for j in range(start[c], start[c + 1]):
+                    if j == i:
+                        continue
+                    rx = x[j] + shift - x[i]
+                    rz = z[j] - z[i]
+                    r2 = rx * rx + rz * rz
+                    if r2 >= four_h2:
+                        continue
+                    px = x[j] + shift - tx
+                    pz = z[j] - tz
+                    if r2 >= two_h2:
+                        occupied = px * px + pz * pz < h * h
+                    else:
+                        occupied = abs(nx * px + nz * pz) + abs(-nz * px + nx * pz) < h
+                    if occupied:
+                        break
+                if occupied:
+                    break
+            if occupied:
+                break
+        if not occupied:
+            flag[i] = 1
+
+
+@nb.njit(parallel=True, cache=True)
+def lind_shift(x, z, kind, gcx, gcz, surface, wnx, wnz, s0, start, n_active, ncx, ncz, periodic,
+               period, x0, z0, csx, csz, D, h, clip, dx_out, dz_out):
     four_h2 = 4.0 * h * h
     for i in nb.prange(n_active):
         dx_out[i] = 0.0
         dz_out[i] = 0.0
-        if kind[i] != 0 or divr[i] < thr:
+        if kind[i] != 0 or surface[i]:
             continue
         ix = int(math.floor((x[i] - x0) / csx))
         iz = int(math.floor((z[i] - z0) / csz))
@@ -95,7 +164,7 @@ def lind_shift(x, z, kind, gcx, gcz, divr, wnx, wnz, s0, start, n_active, ncx, n
                     continue
                 c = jx * ncz + jz
                 for j in range(start[c], start[c + 1]):
-                    if kind[j] != 0 or divr[j] >= thr:
+                    if not surface[j]:
                         continue
                     ex = x[i] - (x[j] + shift)
                     ez = z[i] - z[j]
@@ -107,7 +176,8 @@ def lind_shift(x, z, kind, gcx, gcz, divr, wnx, wnz, s0, start, n_active, ncx, n
             if near_surface:
                 break
         if not near_surface:
-            dx_out[i], dz_out[i] = _off_wall(-D * gcx[i], -D * gcz[i], wnx[i], wnz[i], s0)
+            dx_out[i], dz_out[i] = _off_wall(min(max(-D * gcx[i], -clip), clip),
+                                             min(max(-D * gcz[i], -clip), clip), wnx[i], wnz[i], s0)
 
 
 @nb.njit(parallel=True, cache=True)

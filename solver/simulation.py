@@ -89,6 +89,7 @@ class Simulation:
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
         self.shift_div = np.zeros(self.n)
+        self.surface_flag = np.zeros(self.n, dtype=np.int8)
         self.wall_s0 = shifting.wall_proximity_at_half_dp(self.h, s.dp)
         self._buf = {np.dtype(a.dtype): np.empty(self.n, a.dtype)
                      for a in (self.x, self.kind, self.wall, self.pid)}
@@ -162,10 +163,14 @@ class Simulation:
                                    self.h, dt, sh.surface_threshold, sh.max_shift * self.scene.dp,
                                    self.shift_dx, self.shift_dz)
         else:
-            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, divr, wnx, wnz, self.wall_s0, self.start, self.n_active,
-                                g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0, g.csx, g.csz,
-                                0.5 * A * self.h * self.h, self.h, sh.surface_threshold,
-                                self.shift_dx, self.shift_dz)
+            shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.start,
+                                  self.n_active, g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0,
+                                  g.csx, g.csz, self.h, sh.surface_threshold, shifting.SCAN_UPPER,
+                                  self.surface_flag)
+            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, self.surface_flag, wnx, wnz,
+                                self.wall_s0, self.start, self.n_active, g.ncx, g.ncz, g.periodic,
+                                g.period, g.x0, g.z0, g.csx, g.csz, 0.5 * A * self.h * self.h,
+                                self.h, sh.max_shift * self.scene.dp, self.shift_dx, self.shift_dz)
         if sh.density_correction:  # rho follows the volume change of the shift
             shifting.shift_divergence(self.x, self.z, self.kind, self.mass, self.rho, self.shift_dx,
                                       self.shift_dz, self.start, self.n_active, g.ncx, g.ncz,

@@ -40,7 +40,8 @@ def test_preset_geometry(start):
     g = scene.gravity
     assert math.degrees(math.atan2(g[0], -g[1])) == pytest.approx(15.3)
     assert math.hypot(*g) == pytest.approx(9.81)
-    belt, upstream = scene.walls
+    belt, upstream, still = scene.walls
+    assert still.velocity == (0.0, 0.0) and still.x == (0.0, belt.x[0]) and belt.x[0] > 0
     assert belt.velocity == (-0.075, 0.0) and not belt.moving
     assert belt.ramp_delay == c.belt.rest and belt.ramp_time == c.belt.ramp
     assert upstream.velocity == (0.0, 0.0) and upstream.x[1] == 0.0

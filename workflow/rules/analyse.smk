@@ -1,0 +1,22 @@
+rule metrics:
+    input:
+        "results/cases/{case}/run.nc",
+    output:
+        "results/cases/{case}/metrics.nc",
+    params:
+        settings=lambda wc: yaml.safe_dump({k: config[k] for k in ("reference", "metrics")}),
+        config=CONFIG_FILE,
+    shell:
+        "python -m study metrics {params.config} {input} -o {output}"
+
+
+rule campaign:
+    input:
+        runs=expand("results/cases/{case}/run.nc", case=CASE_IDS),
+        metrics=expand("results/cases/{case}/metrics.nc", case=CASE_IDS),
+    output:
+        "results/campaign.nc",
+    params:
+        config=CONFIG_FILE,
+    shell:
+        "python -m study reduce {params.config} --results results/cases -o {output}"

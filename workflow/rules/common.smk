@@ -1,0 +1,37 @@
+# Config validation (schema, then what a schema cannot check) before any job starts,
+# and the case grid.
+import yaml
+from study.config import SCHEMA, validate as validate_campaign, cases as campaign_cases, case_dict
+from study.grid import CASE_ID
+
+validate(config, str(SCHEMA))
+config = validate_campaign(config)
+CASES = campaign_cases(config)
+CASE_IDS = [c.id for c in CASES]
+CASE_BY_ID = {c.id: c for c in CASES}
+RES = config["resources"]
+
+
+def _write_if_changed(path, text):
+    """The merged, validated config for our CLIs; rewritten only when it changes. Rules take
+    it as a param, not an input, and list the settings they use as params, so a change to
+    figure settings does not rerun simulations."""
+    import os
+    old = open(path).read() if os.path.exists(path) else None
+    if old != text:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path + ".tmp", "w") as fh:
+            fh.write(text)
+        os.replace(path + ".tmp", path)
+
+
+CONFIG_FILE = "results/campaign_config.yaml"
+_write_if_changed(CONFIG_FILE, yaml.safe_dump(config, sort_keys=False))
+
+wildcard_constraints:
+    case=CASE_ID,
+
+
+def case_yaml(wildcards):
+    """The solver case of one campaign case: a param, so only its own settings rerun it."""
+    return yaml.safe_dump(case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=False)

@@ -1,0 +1,35 @@
+rule compile_kernels:
+    output:
+        touch("results/.kernels_compiled"),
+    log:
+        "results/logs/compile_kernels.log",
+    shell:
+        "python -m solver warm 2> {log}"
+
+
+rule case_file:
+    output:
+        "results/cases/{case}/case.yaml",
+    params:
+        text=case_yaml,
+    run:
+        import pathlib
+        pathlib.Path(output[0]).write_text(params.text)
+
+
+rule run_case:
+    input:
+        case="results/cases/{case}/case.yaml",
+        kernels="results/.kernels_compiled",
+    output:
+        "results/cases/{case}/run.nc",
+    log:
+        "results/logs/run_{case}.log",
+    threads: RES["threads"]
+    resources:
+        runtime=RES["runtime_min"],
+        mem_mb=RES["mem_mb"],
+    shell:
+        "NUMBA_NUM_THREADS={threads} python -m solver front {input.case} -o {output} "
+        "--threads {threads} --quiet --allow-diverged "
+        "--checkpoint results/checkpoints/{wildcards.case}.ckpt 2> {log}"

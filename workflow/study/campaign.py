@@ -1,0 +1,121 @@
+"""Reduce per-case results into the campaign dataset: dimensions (dp, ch, shifting) for the
+grid, and a flat ``case`` table of every case (grid and extra)."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .grid import Case
+
+SCALARS = ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_fs_measured")
+RUN_NUMBERS = {
+    "wall_time": ("wall_time_s", "s", "wall-clock time of the run"),
+    "steps": ("steps", "1", "time steps"),
+    "n_particles": ("n_particles", "1", "particles (fluid and wall)"),
+    "simulated_time": ("simulated_time_s", "s", "simulated time"),
+    "steady_state_time": ("steady_state_time_s", "s", "time steady state was detected"),
+    "threads": ("threads", "1", "threads"),
+}
+FRONT_XSTAR = 3.0  # particles within this x* of the toe are kept for the front figure
+
+
+def _front_particles(run: xr.Dataset, max_n: int):
+    """Fluid particle positions (x*, z*) within FRONT_XSTAR of the toe in the final snapshot."""
+    if "snapshot" not in run.dims or "toe_position" not in run or run.sizes.get("time", 0) == 0:
+        return np.full(max_n, np.nan), np.full(max_n, np.nan)
+    s = run.isel(snapshot=-1)
+    hn = float(run.attrs["h_n_m"])
+    toe = float(run["toe_position"].values[-1])
+    f = s["kind"].values == 0
+    xs = (toe - s["x"].values[f]) / hn
+    zs = s["z"].values[f] / hn
+    keep = (xs >= -0.5) & (xs <= FRONT_XSTAR)
+    xs, zs = xs[keep][:max_n], zs[keep][:max_n]
+    px, pz = np.full(max_n, np.nan), np.full(max_n, np.nan)
+    px[:xs.size], pz[:zs.size] = xs, zs
+    return px, pz
+
+
+def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
+          front_particles: int = 4000) -> xr.Dataset:
+    """The campaign dataset from each case's run and metrics datasets (same order)."""
+    grid = [c for c in cases if c.on_grid]
+    dps = sorted({c.dp for c in grid}, reverse=True)
+    chs = sorted({c.ch for c in grid})
+    shs = list(dict.fromkeys(c.shifting for c in grid))
+    stations = metrics[0]["station"].values
+    x_star = next((r["x_star"].values for r in runs if "x_star" in r.coords), np.zeros(0))
+    z_star = next((r["z_star"].values for r in runs if "z_star" in r.coords), np.zeros(0))
+    shape = (len(dps), len(chs), len(shs))
+    arr = lambda *extra: np.full(shape + extra, np.nan)  # noqa: E731
+    data = {k: arr() for k in SCALARS}
+    data["zeta_u"] = arr(stations.size)
+    data["zeta_u_measured"] = arr(stations.size)
+    for k in RUN_NUMBERS:
+        data[k] = arr()
+    data["mean_surface"] = arr(x_star.size)
+    data["mean_velocity"] = arr(stations.size, z_star.size)
+    data["front_x"] = arr(front_particles)
+    data["front_z"] = arr(front_particles)
+    status = np.full(shape, "missing", dtype=object)
+    reason = np.full(shape, "", dtype=object)
+    case_ids = np.full(shape, "", dtype=object)
+
+    for c, run, m in zip(cases, runs, metrics):
+        if not c.on_grid:
+            continue
+        ix = (dps.index(c.dp), chs.index(c.ch), shs.index(c.shifting))
+        for k in SCALARS:
+            data[k][ix] = float(m[k])
+        data["zeta_u"][ix] = m["zeta_u"].values
+        data["zeta_u_measured"][ix] = m["zeta_u_measured"].values
+        for k, (attr, _, _) in RUN_NUMBERS.items():
+            data[k][ix] = float(run.attrs.get(attr, np.nan))
+        if "mean_surface_elevation" in run:
+            data["mean_surface"][ix] = run["mean_surface_elevation"].values / run.attrs["h_n_m"]
+            data["mean_velocity"][ix] = run["mean_velocity_star"].values
+        data["front_x"][ix], data["front_z"][ix] = _front_particles(run, front_particles)
+        status[ix], reason[ix], case_ids[ix] = run.attrs["status"], run.attrs["reason"], c.id
+
+    dims = ("dp", "ch", "shifting")
+    ds = xr.Dataset(
+        {**{k: (dims, data[k]) for k in SCALARS + tuple(RUN_NUMBERS)},
+         "zeta_u": (dims + ("station",), data["zeta_u"]),
+         "zeta_u_measured": (dims + ("station",), data["zeta_u_measured"]),
+         "mean_surface": (dims + ("x_star",), data["mean_surface"]),
+         "mean_velocity": (dims + ("station", "z_star"), data["mean_velocity"]),
+         "front_x": (dims + ("front_particle",), data["front_x"]),
+         "front_z": (dims + ("front_particle",), data["front_z"]),
+         "status": (dims, status.astype(str)),
+         "reason": (dims, reason.astype(str)),
+         "case_id": (dims, case_ids.astype(str))},
+        coords={"dp": ("dp", np.array(dps), {"units": "m", "long_name": "particle spacing"}),
+                "ch": ("ch", np.array(chs), {"units": "1", "long_name": "h / dp"}),
+                "shifting": ("shifting", np.array(shs, dtype=str)),
+                "station": ("station", stations, {"units": "1", "long_name": "station x*"}),
+                "x_star": ("x_star", x_star, {"units": "1"}), "z_star": ("z_star", z_star, {"units": "1"})})
+    for k in SCALARS:
+        ds[k].attrs.update(metrics[0][k].attrs)
+    for k in ("zeta_u", "zeta_u_measured"):
+        ds[k].attrs.update(metrics[0][k].attrs)
+    for k, (_, units, long) in RUN_NUMBERS.items():
+        ds[k].attrs.update(units=units, long_name=long)
+    ds["mean_surface"].attrs.update(units="1", long_name="steady free surface h/h_n")
+    ds["mean_velocity"].attrs.update(units="1", long_name="steady u* (belt frame)")
+    ds["front_x"].attrs.update(units="1", long_name="final fluid particles near the front, x* upslope of toe")
+    ds["front_z"].attrs.update(units="1", long_name="final fluid particles near the front, z/h_n")
+
+    # flat table of every case, extra ones included
+    ds = ds.assign_coords(case=("case", [c.id for c in cases]))
+    ds["case_dp"] = ("case", [c.dp for c in cases], {"units": "m"})
+    ds["case_ch"] = ("case", [c.ch for c in cases])
+    ds["case_shifting"] = ("case", [c.shifting for c in cases])
+    ds["case_on_grid"] = ("case", [int(c.on_grid) for c in cases])
+    ds["case_status"] = ("case", [r.attrs["status"] for r in runs])
+    ds["case_reason"] = ("case", [r.attrs["reason"] for r in runs])
+    for k, (attr, units, long) in RUN_NUMBERS.items():
+        ds[f"case_{k}"] = ("case", [float(r.attrs.get(attr, np.nan)) for r in runs], {"units": units})
+    for k in SCALARS:
+        ds[f"case_{k}"] = ("case", [float(m[k]) for m in metrics])
+    ds["case_zeta_u"] = (("case", "station"), np.stack([m["zeta_u"].values for m in metrics]))
+    return ds

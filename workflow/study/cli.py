@@ -1,0 +1,153 @@
+"""``python -m study COMMAND``: the small CLIs the Snakemake rules call."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def _cfg(path):
+    from .config import load
+    return load(path)
+
+
+def cmd_validate(a):
+    from .config import cases
+    cfg = _cfg(a.config)
+    cs = cases(cfg)
+    print(f"{a.config}: valid, {len(cs)} cases")
+    for c in cs:
+        print("  " + c.id)
+
+
+def cmd_case_file(a):
+    import yaml
+    from .config import case_dict, cases
+    cfg = _cfg(a.config)
+    match = [c for c in cases(cfg) if c.id == a.case]
+    if not match:
+        raise SystemExit(f"error: case {a.case!r} is not in {a.config}")
+    _write_text(a.output, yaml.safe_dump(case_dict(cfg, match[0]), sort_keys=False))
+
+
+def _reference(cfg, run=None):
+    import numpy as np
+    from .reference import read_surface_csv, read_velocity_csv, theory
+    lo, hi = cfg["metrics"]["free_surface_x_star"]
+    x = np.round(np.arange(lo, hi + 1e-9, 0.1), 10)
+    z = np.round(np.arange(0.0, 1.3 + 1e-9, 0.025), 10)
+    slope = cfg["case"].get("slope_deg", 15.3)
+    ref = theory(x, cfg["metrics"]["stations"], z, slope)
+    m = cfg["reference"]["measured"]
+    measured = {"surface": read_surface_csv(m["free_surface"]) if m.get("free_surface") else None,
+                "velocity": {float(k): read_velocity_csv(v) for k, v in (m.get("velocity") or {}).items()}}
+    return ref, measured
+
+
+def cmd_metrics(a):
+    import xarray as xr
+    from solver.output import write_atomic
+    from .metrics import case_metrics
+    cfg = _cfg(a.config)
+    ref, measured = _reference(cfg)
+    with xr.open_dataset(a.run) as run:
+        m = case_metrics(run.load(), ref, tuple(cfg["metrics"]["free_surface_x_star"]), measured)
+    m.attrs["case"] = Path(a.run).parent.name
+    write_atomic(m, a.output)
+
+
+def cmd_reduce(a):
+    import xarray as xr
+    from solver.output import write_atomic
+    from .campaign import build
+    from .config import cases
+    cfg = _cfg(a.config)
+    cs = cases(cfg)
+    runs, metrics = [], []
+    for c in cs:
+        with xr.open_dataset(Path(a.results) / c.id / "run.nc") as r:
+            runs.append(r.load())
+        with xr.open_dataset(Path(a.results) / c.id / "metrics.nc") as m:
+            metrics.append(m.load())
+    ds = build(cs, runs, metrics)
+    import yaml
+    ds.attrs.update(h_n_m=float(runs[0].attrs.get("h_n_m", float("nan"))),
+                    normalising_depth_m=float(cfg["reference"]["normalising_depth"]),
+                    slope_deg=float(cfg["case"].get("slope_deg", 15.3)),
+                    config_yaml=yaml.safe_dump(cfg, sort_keys=False),
+                    version_numba=str(runs[0].attrs.get("version_numba", "")))
+    write_atomic(ds, a.output)
+
+
+def cmd_figures(a):
+    import xarray as xr
+    from .figures import write_all
+    cfg = _cfg(a.config)
+    f = cfg["figures"]
+    with xr.open_dataset(a.campaign) as ds:
+        paths = write_all(ds.load(), a.outdir, fmt=f["format"], dpi=f["dpi"],
+                          profile_ch=f["profile_ch"], slope_deg=ds.attrs.get("slope_deg", 15.3))
+    for p in paths:
+        print(p)
+
+
+def cmd_report(a):
+    import xarray as xr
+    import yaml
+    from .figures import all_figures
+    from .report import render, write
+    cfg = _cfg(a.config)
+    f = cfg["figures"]
+    with xr.open_dataset(a.campaign) as ds:
+        ds = ds.load()
+    import matplotlib.pyplot as plt
+    figs = []
+    for fig in all_figures(ds, profile_ch=f["profile_ch"], slope_deg=ds.attrs.get("slope_deg", 15.3)):
+        p = Path(a.figures) / f"{fig.name}.{f['format']}"
+        if not p.exists():
+            raise SystemExit(f"error: missing figure {p}; run the figures step first")
+        figs.append((p, fig.title, fig.caption))
+        plt.close(fig.fig)
+    write(render(ds, figs, yaml.safe_dump(cfg, sort_keys=False)), a.output)
+    print(a.output)
+
+
+def _write_text(path, text):
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m study", description=__doc__)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    p = sub.add_parser("validate", help="validate a campaign config and list its cases")
+    p.add_argument("config")
+    p.set_defaults(fn=cmd_validate)
+    p = sub.add_parser("case-file", help="write the solver case file of one case")
+    p.add_argument("config"); p.add_argument("case"); p.add_argument("-o", "--output", required=True)  # noqa: E702
+    p.set_defaults(fn=cmd_case_file)
+    p = sub.add_parser("metrics", help="metrics of one run against the reference")
+    p.add_argument("config"); p.add_argument("run"); p.add_argument("-o", "--output", required=True)  # noqa: E702
+    p.set_defaults(fn=cmd_metrics)
+    p = sub.add_parser("reduce", help="campaign dataset from every case")
+    p.add_argument("config"); p.add_argument("--results", default="results/cases")  # noqa: E702
+    p.add_argument("-o", "--output", required=True)
+    p.set_defaults(fn=cmd_reduce)
+    p = sub.add_parser("figures", help="the paper's figures from the campaign dataset")
+    p.add_argument("config"); p.add_argument("campaign"); p.add_argument("-o", "--outdir", required=True)  # noqa: E702
+    p.set_defaults(fn=cmd_figures)
+    p = sub.add_parser("report", help="self-contained HTML report")
+    p.add_argument("config"); p.add_argument("campaign"); p.add_argument("--figures", required=True)  # noqa: E702
+    p.add_argument("-o", "--output", required=True)
+    p.set_defaults(fn=cmd_report)
+    a = ap.parse_args(argv)
+    from .config import ConfigError
+    try:
+        a.fn(a)
+    except ConfigError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0

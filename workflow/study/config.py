@@ -1,0 +1,91 @@
+"""Campaign configuration: schema validation, defaults, and the per-case solver files."""
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import yaml
+
+from .grid import Case, expand
+
+SCHEMA = Path(__file__).resolve().parent / "config.schema.yaml"
+
+
+class ConfigError(ValueError):
+    """The campaign configuration is invalid; the message names the key."""
+
+
+def load_schema() -> dict:
+    with open(SCHEMA) as fh:
+        return yaml.safe_load(fh)
+
+
+def _path(err) -> str:
+    p = ".".join(str(x) for x in err.absolute_path)
+    return p or "(top level)"
+
+
+def validate(config: dict) -> dict:
+    """Validate against the JSON schema (filling defaults) and check what a schema cannot.
+
+    Returns the config with defaults; raises ConfigError naming the key.
+    """
+    import jsonschema
+    cfg = copy.deepcopy(config)
+    schema = load_schema()
+    validator_cls = jsonschema.validators.validator_for(schema)
+
+    def set_defaults(validator, properties, instance, schema):  # fill defaults while validating
+        for name, sub in properties.items():
+            if isinstance(instance, dict) and "default" in sub and name not in instance:
+                instance[name] = copy.deepcopy(sub["default"])
+        yield from validator_cls.VALIDATORS["properties"](validator, properties, instance, schema)
+
+    Defaulting = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
+    errors = sorted(Defaulting(schema).iter_errors(cfg), key=lambda e: list(e.absolute_path))
+    if errors:
+        e = errors[0]
+        raise ConfigError(f"config key {_path(e)}: {e.message}")
+    try:
+        cases = expand(cfg["grid"], cfg.get("extra_cases"))
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
+    # every case must make a valid solver case: check now, before any job starts
+    from solver.conveyor import case_from_dict
+    from solver.scene import SceneError
+    for c in cases:
+        try:
+            case_from_dict(case_dict(cfg, c))
+        except SceneError as exc:
+            raise ConfigError(f"case {c.id}: {exc}") from None
+    return cfg
+
+
+def load(path) -> dict:
+    with open(path) as fh:
+        return validate(yaml.safe_load(fh) or {})
+
+
+def cases(cfg: dict) -> list[Case]:
+    return expand(cfg["grid"], cfg.get("extra_cases"))
+
+
+def _merge(base: dict, changes: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in changes.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def case_dict(cfg: dict, case: Case) -> dict:
+    """The solver's case file (solver.conveyor) for one campaign case."""
+    d = _merge(cfg["case"], case.overrides)
+    d.update(name=case.id, dp=case.dp, ch=case.ch, shifting=case.shifting)
+    d["normalising_depth"] = cfg["reference"]["normalising_depth"]
+    probes = d.setdefault("probes", {})
+    probes.setdefault("stations", list(cfg["metrics"]["stations"]))
+    probes.setdefault("uniform_zone", list(cfg["metrics"]["uniform_zone"]))
+    return d

@@ -1,0 +1,60 @@
+"""Case grid: dp x Ch x shifting from the config, with canonical, float-safe case ids."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+CASE_ID = r"dp[0-9]+(?:\.[0-9]+)?mm_ch[0-9]+(?:\.[0-9]+)?_(?:none|skillen|lind)(?:_[a-z0-9-]+)?"
+_NUM = re.compile(r"^-?[0-9]+(\.[0-9]+)?$")
+
+
+def fmt(x: float, digits: int = 6) -> str:
+    """Shortest decimal form of x with at most ``digits`` decimals, never exponent notation:
+    0.30000000000000004 -> '0.3', 1.0 -> '1', 0.25 -> '0.25'."""
+    s = f"{round(float(x), digits):.{digits}f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def case_id(dp: float, ch: float, shifting: str, tag: str | None = None) -> str:
+    """E.g. dp1mm_ch1.8_lind; dp in mm."""
+    cid = f"dp{fmt(dp * 1000.0)}mm_ch{fmt(ch)}_{shifting}"
+    return f"{cid}_{tag}" if tag else cid
+
+
+@dataclass(frozen=True)
+class Case:
+    dp: float
+    ch: float
+    shifting: str
+    tag: str | None = None
+    overrides: dict = field(default_factory=dict, compare=False, hash=False)
+
+    @property
+    def id(self) -> str:
+        return case_id(self.dp, self.ch, self.shifting, self.tag)
+
+    @property
+    def on_grid(self) -> bool:
+        return self.tag is None
+
+
+def expand(grid: dict, extra: list[dict] | None = None) -> list[Case]:
+    """Cases of the grid (``combine``: product, or paper = every Ch with the first shifting
+    method plus every method at ``paper_ch``) followed by the extra cases; ids unique."""
+    dps, chs, shifts = grid["dp"], grid["ch"], grid["shifting"]
+    combine = grid.get("combine", "product")
+    cases = []
+    for dp in dps:
+        for ch in chs:
+            for sh in shifts:
+                if combine == "paper" and sh != shifts[0] and ch != grid.get("paper_ch", 1.8):
+                    continue
+                cases.append(Case(float(dp), float(ch), sh))
+    for e in extra or []:
+        cases.append(Case(float(e["dp"]), float(e["ch"]), e["shifting"], e.get("tag"),
+                          dict(e.get("overrides") or {})))
+    ids = [c.id for c in cases]
+    dup = sorted({i for i in ids if ids.count(i) > 1})
+    if dup:
+        raise ValueError(f"extra_cases: duplicate case id(s) {', '.join(dup)}; give each a distinct 'tag'")
+    return cases

@@ -1,0 +1,55 @@
+"""Reference solution (SPEC section 5): lubrication theory, and optional measured CSV data."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from solver import lubrication
+
+
+def theory(x_star: np.ndarray, stations, z_star: np.ndarray, slope_deg: float) -> xr.Dataset:
+    """Free surface eta(x*) and belt-frame velocity u*(z*) at each station (local depth
+    h = eta h_n; NaN above it), as functions of x* = xi/h_n and z* = z/h_n."""
+    theta = math.radians(slope_deg)
+    eta = lubrication.front_eta(np.asarray(x_star, dtype=float), theta)
+    st = np.asarray(stations, dtype=float)
+    eta_st = lubrication.front_eta(st, theta)
+    zs = np.asarray(z_star, dtype=float)
+    s = zs[None, :] / eta_st[:, None]
+    u = np.where(s <= 1.0 + 1e-12, lubrication.belt_velocity(np.minimum(s, 1.0)), np.nan)
+    return xr.Dataset(
+        {"surface": ("x_star", eta, {"units": "1", "long_name": "theory free surface h/h_n"}),
+         "station_depth": ("station", eta_st, {"units": "1", "long_name": "theory depth h/h_n at the station"}),
+         "velocity": (("station", "z_star"), u, {"units": "1", "long_name": "theory u* (belt frame)"})},
+        coords={"x_star": np.asarray(x_star, dtype=float), "station": st, "z_star": zs},
+        attrs={"source": "lubrication theory (SPEC section 5)"})
+
+
+def read_surface_csv(path) -> xr.DataArray:
+    """Measured free surface: CSV with columns x_star, z_star."""
+    df = _read(path, ("x_star", "z_star"))
+    return xr.DataArray(df["z_star"].to_numpy(), coords={"x_star": df["x_star"].to_numpy()},
+                        dims="x_star", name="surface", attrs={"source": str(path)})
+
+
+def read_velocity_csv(path) -> xr.DataArray:
+    """Measured velocity profile at one station: CSV with columns z_star, u_star."""
+    df = _read(path, ("z_star", "u_star"))
+    return xr.DataArray(df["u_star"].to_numpy(), coords={"z_star": df["z_star"].to_numpy()},
+                        dims="z_star", name="velocity", attrs={"source": str(path)})
+
+
+def _read(path, columns) -> pd.DataFrame:
+    path = Path(path)
+    df = pd.read_csv(path, comment="#")
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise ValueError(f"{path}: missing column(s) {', '.join(missing)}; expected {', '.join(columns)}")
+    df = df[list(columns)].astype(float).dropna().sort_values(columns[0])
+    if len(df) < 2:
+        raise ValueError(f"{path}: needs at least two rows")
+    return df

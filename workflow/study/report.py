@@ -1,0 +1,116 @@
+"""Self-contained HTML report: configuration, case table, figures with captions, provenance."""
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import os
+import platform
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+SECTIONS = ("Summary", "Configuration", "Cases", "Figures", "Provenance")
+CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
+h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
+table{border-collapse:collapse;font-size:.85em}td,th{border:1px solid #ddd;padding:3px 6px;text-align:right}
+th{background:#f3f3f3}td.l,th.l{text-align:left}tr.diverged td{background:#fde2e1}tr.not_steady td{background:#fff4d6}
+figure{margin:1.5em 0}figcaption{font-size:.9em;color:#444;max-width:900px}img{max-width:100%}
+pre{background:#f7f7f7;padding:.8em;overflow-x:auto;font-size:.85em}
+"""
+
+
+def _fmt(v, digits=3):
+    if isinstance(v, str):
+        return html.escape(v)
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return html.escape(str(v))
+    if not np.isfinite(v):
+        return "&ndash;"
+    if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e5):
+        return f"{v:.{digits}e}"
+    return f"{v:.{digits}g}"
+
+
+def _commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, timeout=5).stdout.strip() or "unknown"
+    except Exception:
+        return "unknown"
+
+
+def case_table(ds: xr.Dataset) -> str:
+    st = ds["station"].values
+    head = ["case", "status", "wall time [s]", "steps", "particles", "steady at [s]",
+            "zeta_f", "zeta_h (h_n)", "zeta_h (paper)", "zeta_fs"] + [f"zeta_u x*={s:g}" for s in st]
+    rows = []
+    for i, cid in enumerate(ds["case"].values):
+        status = str(ds["case_status"].values[i])
+        reason = str(ds["case_reason"].values[i])
+        cells = [f'<td class="l">{html.escape(str(cid))}</td>',
+                 f'<td class="l" title="{html.escape(reason)}">{html.escape(status)}'
+                 + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>"]
+        for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time",
+                  "case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
+            cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
+        for j in range(st.size):
+            cells.append(f"<td>{_fmt(ds['case_zeta_u'].values[i, j])}</td>")
+        rows.append(f'<tr class="{html.escape(status)}">' + "".join(cells) + "</tr>")
+    th = "".join(f'<th class="{"l" if k < 2 else ""}">{html.escape(h)}</th>' for k, h in enumerate(head))
+    return f"<table><tr>{th}</tr>{''.join(rows)}</table>"
+
+
+def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: str,
+           extra_sections: list[tuple[str, str]] = ()) -> str:
+    """HTML text; ``figures`` as (image path, title, caption); images are embedded."""
+    n = ds.sizes["case"]
+    statuses = [str(s) for s in ds["case_status"].values]
+    counts = {s: statuses.count(s) for s in sorted(set(statuses))}
+    wall = np.nansum(ds["case_wall_time"].values)
+    summary = (f"<p>{n} cases: " + ", ".join(f"{v} {html.escape(k)}" for k, v in counts.items())
+               + f". Total simulation wall time {wall:.0f} s.</p>"
+               + "<p>Metrics (SPEC section 4) are computed against lubrication theory over the "
+               "steady averaging window of each run; diverged and unsteady runs have no metrics. "
+               f"zeta_h is given against the computed normal depth h_n = "
+               f"{_fmt(ds.attrs.get('h_n_m', np.nan) * 1000, 4)} mm and against the paper's "
+               f"normalising depth {_fmt(ds.attrs.get('normalising_depth_m', np.nan) * 1000, 4)} mm.</p>")
+    figs = []
+    for path, title, caption in figures:
+        data = base64.b64encode(Path(path).read_bytes()).decode()
+        mime = "image/svg+xml" if str(path).endswith(".svg") else "image/png"
+        figs.append(f'<figure id="{html.escape(Path(path).stem)}"><h3>{html.escape(title)}</h3>'
+                    f'<img alt="{html.escape(title)}" src="data:{mime};base64,{data}">'
+                    f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+    import matplotlib
+    import snakemake
+    import solver
+    prov = {"date (UTC)": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M"),
+            "commit": _commit(), "host": platform.node(), "python": platform.python_version(),
+            "sph-surge": solver.__version__, "numpy": np.__version__, "xarray": xr.__version__,
+            "matplotlib": matplotlib.__version__, "snakemake": snakemake.__version__,
+            "numba": ds.attrs.get("version_numba", ""), "cwd": os.getcwd()}
+    prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th><td class="l">{html.escape(str(v))}</td></tr>'
+                                    for k, v in prov.items()) + "</table>"
+    body = [("Summary", summary), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
+            ("Cases", case_table(ds)), *extra_sections,
+            ("Figures", "".join(figs)), ("Provenance", prov_html)]
+    toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
+    sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
+                       for t, c in body)
+    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            f"<title>sph-surge campaign report</title><style>{CSS}</style></head><body>"
+            f"<h1>sph-surge campaign report</h1><nav><ul>{toc}</ul></nav>{sections}</body></html>")
+
+
+def write(text: str, path) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
