@@ -49,7 +49,8 @@ class Belt:
     rest: float = 0.05  # s at rest before the ramp
     ramp: float = 0.25  # s to reach full speed
     margin: float = 8.0  # belt length downstream of the initial toe, in h_n
-    still_length: float = 0.25  # in h_n: the belt's first stretch at the upstream wall is at rest
+    taper_length: float = 1.0  # in h_n: the belt speed rises from the upstream wall over this length
+    taper_segments: int = 5
 
 
 @dataclass
@@ -137,8 +138,10 @@ def validate_case(c: ConveyorCase) -> None:
         raise SceneError(f"case.start: {c.start!r} is not one of {', '.join(START_SHAPES)}")
     positive(c.belt.speed, "case.belt.speed")
     positive(c.belt.margin, "case.belt.margin")
-    if c.belt.rest < 0 or c.belt.ramp < 0 or c.belt.still_length < 0:
-        raise SceneError("case.belt.rest, case.belt.ramp, case.belt.still_length: must be >= 0")
+    if c.belt.rest < 0 or c.belt.ramp < 0 or c.belt.taper_length < 0:
+        raise SceneError("case.belt.rest, case.belt.ramp, case.belt.taper_length: must be >= 0")
+    if c.belt.taper_segments < 1:
+        raise SceneError("case.belt.taper_segments: must be >= 1")
     p = c.probes
     for key in ("interval", "x_star_max", "x_star_step", "z_star_step", "z_star_max"):
         positive(getattr(p, key), f"case.probes.{key}")
@@ -201,9 +204,16 @@ def build_scene_dict(c: ConveyorCase) -> dict:
     x_toe = initial_toe(c)
     belt_end = c.dp * math.ceil((x_toe + c.belt.margin * hn) / c.dp)
     wall_top = c.dp * math.ceil(c.wall_height * hn / c.dp)
-    # a belt running into the fixed wall is a corner singularity that squeezes the corner
-    # particles through the wall: the first stretch of belt is held still
-    still = c.dp * round(c.belt.still_length * hn / c.dp)
+    # a belt running at full speed into the fixed wall is a corner singularity that squeezes
+    # particles through the wall; over taper_length from the wall the belt speed rises in
+    # taper_segments steps, (k + 1/2) / n u_b on the k-th
+    n = c.belt.taper_segments if c.belt.taper_length > 0 else 0
+    edges = [c.dp * round(k * c.belt.taper_length * hn / max(n, 1) / c.dp) for k in range(n + 1)]
+    taper = [{"name": f"belt_taper{k}", "x": [edges[k], edges[k + 1]], "z": [-T, 0.0],
+              "velocity": [-(k + 0.5) / n * c.belt.speed, 0.0], "moving": False,
+              "ramp_time": c.belt.ramp, "ramp_delay": c.belt.rest}
+             for k in range(n) if edges[k + 1] > edges[k]]
+    belt_start = edges[-1] if n else 0.0
     if c.start == "block":
         fluid = {"blocks": [{"x": [0.0, x_toe], "z": [0.0, hn]}]}
     else:
@@ -217,11 +227,11 @@ def build_scene_dict(c: ConveyorCase) -> dict:
         "dp": c.dp, "ch": c.ch,
         "fluid": {"density": c.density, "viscosity": c.viscosity, **fluid},
         "walls": [
-            {"name": "belt", "x": [still, belt_end], "z": [-T, 0.0],
+            {"name": "belt", "x": [belt_start, belt_end], "z": [-T, 0.0],
              "velocity": [-c.belt.speed, 0.0], "moving": False,
              "ramp_time": c.belt.ramp, "ramp_delay": c.belt.rest},
             {"name": "upstream", "x": [-T, 0.0], "z": [-T, wall_top]},
-        ] + ([{"name": "belt_still", "x": [0.0, still], "z": [-T, 0.0]}] if still > 0 else []),
+        ] + taper,
         "gravity": [g * math.sin(th), -g * math.cos(th)],
         "sound": {"coefsound": c.coefsound, "depth": hn},
         "cfl": c.cfl,

@@ -116,7 +116,9 @@ class Shifting:
     coefficient: float | None = None  # A (skillen, default 2) or A_L (lind, default 1)
     surface_threshold: float = 1.5  # div r below this marks the free surface
     max_shift: float = 0.1  # skillen: clip of each component, in units of dp
-    density_correction: bool = True  # rho *= 1 - div(dr): shifting keeps volume and density consistent
+    # rho *= 1 - div(dr): shifting keeps volume and density consistent; null = on for skillen,
+    # off for lind (whose per-step D = h^2/2 makes the coupling unstable)
+    density_correction: bool | None = None
 
 
 @dataclass
@@ -178,6 +180,11 @@ class Scene:
             return self.sound.c0
         g = math.hypot(*self.gravity)
         return self.sound.coefsound * math.sqrt(g * self.sound.depth)
+
+    @property
+    def shift_density_correction(self) -> bool:
+        s = self.physics.shifting
+        return s.density_correction if s.density_correction is not None else s.method == "skillen"
 
     @property
     def shifting_coefficient(self) -> float:
@@ -262,9 +269,9 @@ def parse_into(tp, value, key):
     if origin is type(None) or tp is type(None):
         return None
     if args and type(None) in args:  # Optional[...]
-        if value is None or value is False:
-            return None
         inner = [a for a in args if a is not type(None)][0]
+        if value is None or (value is False and inner is not bool):  # `false` switches off
+            return None
         return parse_into(inner, value, key)
     if origin is tuple:
         if not isinstance(value, (list, tuple)) or len(value) != len(args):

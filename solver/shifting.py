@@ -5,12 +5,14 @@ skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - th
 lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp; no shift for
          particles within 2h of a free-surface particle (div r < thr, or a scan-region test
          where thr <= div r < 1.9, see free_surface).
-Density correction (on by default): shifting moves particles relative to the fluid, so each
+Density correction (default on for skillen, off for lind): shifting moves particles relative to the fluid, so each
 particle's volume changes by V div(dr); with its mass fixed its density becomes
 rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab. Without it, shifting that
 spreads particles near a free surface inflates the fluid at constant density (measured on
 the periodic film: +2.1 % area in 1 s with skillen, +0.17 %/s with lind; with it +0.3 %
-and -0.06 %).
+and -0.06 %). With lind, whose per-step D = h^2/2 moves particles far faster than
+pressure can respond, the correction turns round-off into a growing density mode (measured:
+1e-13 to 5e-5 in 335 steps of a channel at rest), so it is off for lind by default.
 Near a wall (n = kernel-weighted sum sum_b -F_ab n_b of the inward normals of the wall
 particles in reach) the component of dr pointing into the wall is removed once the particle
 is as close as the lattice puts it (|n| at least its value dp/2 from a flat wall): shifting

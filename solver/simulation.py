@@ -171,7 +171,7 @@ class Simulation:
                                 self.wall_s0, self.start, self.n_active, g.ncx, g.ncz, g.periodic,
                                 g.period, g.x0, g.z0, g.csx, g.csz, 0.5 * A * self.h * self.h,
                                 self.h, sh.max_shift * self.scene.dp, self.shift_dx, self.shift_dz)
-        if sh.density_correction:  # rho follows the volume change of the shift
+        if self.scene.shift_density_correction:  # rho follows the volume change of the shift
             shifting.shift_divergence(self.x, self.z, self.kind, self.mass, self.rho, self.shift_dx,
                                       self.shift_dz, self.start, self.n_active, g.ncx, g.ncz,
                                       g.periodic, g.period, g.x0, g.z0, g.csx, g.csz, self.h,

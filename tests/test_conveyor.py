@@ -40,8 +40,11 @@ def test_preset_geometry(start):
     g = scene.gravity
     assert math.degrees(math.atan2(g[0], -g[1])) == pytest.approx(15.3)
     assert math.hypot(*g) == pytest.approx(9.81)
-    belt, upstream, still = scene.walls
-    assert still.velocity == (0.0, 0.0) and still.x == (0.0, belt.x[0]) and belt.x[0] > 0
+    belt, upstream, *taper = scene.walls
+    # the belt speed rises from the wall over taper_length h_n
+    speeds = [-w.velocity[0] for w in taper] + [-belt.velocity[0]]
+    assert speeds == sorted(speeds) and speeds[0] < 0.2 * c.belt.speed
+    assert taper[0].x[0] == 0.0 and belt.x[0] == pytest.approx(c.belt.taper_length * c.h_n, abs=c.dp)
     assert belt.velocity == (-0.075, 0.0) and not belt.moving
     assert belt.ramp_delay == c.belt.rest and belt.ramp_time == c.belt.ramp
     assert upstream.velocity == (0.0, 0.0) and upstream.x[1] == 0.0
