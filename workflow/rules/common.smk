@@ -34,4 +34,4 @@ wildcard_constraints:
 
 def case_yaml(wildcards):
     """The solver case of one campaign case: a param, so only its own settings rerun it."""
-    return yaml.safe_dump(case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=False)
+    return yaml.safe_dump(case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=True)

@@ -1,0 +1,75 @@
+"""A miniature campaign end to end: Snakemake -> per-case NetCDF -> campaign.nc -> report.
+
+Three very coarse, short cases; one is forced to diverge (cfl = 5) and must be shown as such
+while the campaign completes. Then: changing a figure setting reruns no simulation.
+"""
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+ROOT = Path(__file__).resolve().parent.parent
+MINI = ROOT / "tests" / "data" / "mini.yaml"
+
+
+def snakemake(cwd, configfile, *args):
+    return subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"),
+                           "--configfile", str(configfile), "--cores", "2", *args],
+                          cwd=cwd, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def campaign(tmp_path_factory):
+    work = tmp_path_factory.mktemp("campaign")
+    p = snakemake(work, MINI)
+    assert p.returncode == 0, p.stderr[-4000:]
+    return work
+
+
+def test_campaign_dataset(campaign):
+    ds = xr.open_dataset(campaign / "results" / "campaign.nc")
+    assert set(ds.dims) >= {"dp", "ch", "shifting", "station", "case"}
+    for v in ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_u", "wall_time", "steps",
+              "n_particles", "status"):
+        assert v in ds
+    assert ds["zeta_u"].dims == ("dp", "ch", "shifting", "station")
+    status = dict(zip(ds["case"].values, ds["case_status"].values))
+    assert status["dp4mm_ch1.5_skillen_unstable"] == "diverged"
+    i = list(ds["case"].values).index("dp4mm_ch1.5_skillen_unstable")
+    assert "density" in str(ds["case_reason"].values[i])
+    assert np.isnan(ds["case_zeta_f"].values[i])  # no metrics from a diverged run
+    on_grid = ds.sel(ch=1.5, shifting="skillen")
+    assert np.all(on_grid["status"].values == "completed")
+    assert np.all(np.isfinite(on_grid["zeta_h"].values))
+
+
+def test_report_has_every_section(campaign):
+    html = (campaign / "reports" / "report.html").read_text()
+    for section in ("Summary", "Configuration", "Cases", "Figures", "Provenance"):
+        assert f"<h2>{section}</h2>" in html
+    assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
+    assert html.count("data:image/png;base64,") == 9
+    assert "http://" not in html and "https://" not in html  # opens offline
+
+
+def test_figure_settings_do_not_rerun_simulations(campaign, tmp_path):
+    cfg = yaml.safe_load(MINI.read_text())
+    cfg["figures"]["dpi"] = 61
+    changed = tmp_path / "mini_dpi.yaml"
+    changed.write_text(yaml.safe_dump(cfg))
+    p = snakemake(campaign, changed, "-n", "--quiet", "rules")
+    assert p.returncode == 0, p.stderr
+    assert "figures" in p.stdout and "report_html" in p.stdout
+    assert "run_case" not in p.stdout and "metrics" not in p.stdout
+
+
+def test_finished_cases_are_not_recomputed(campaign):
+    (campaign / "reports" / "report.html").unlink()
+    p = snakemake(campaign, MINI, "-n", "--quiet", "rules")
+    assert p.returncode == 0, p.stderr
+    assert "report_html" in p.stdout and "run_case" not in p.stdout

@@ -1,0 +1,185 @@
+"""The study: grid naming, config schema, reference, metrics on synthetic fields, workflow."""
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from study import config as cfgmod
+from study.grid import CASE_ID, Case, case_id, expand, fmt
+from study.metrics import case_metrics, rms_difference, zeta_f, zeta_h
+from study.reference import read_velocity_csv, theory
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def load(name):
+    with open(ROOT / "config" / name) as fh:
+        return yaml.safe_load(fh)
+
+
+# ---- grid -----------------------------------------------------------------------------
+def test_float_safe_names():
+    assert fmt(0.1 + 0.2) == "0.3"
+    assert fmt(np.float64(1.0)) == "1"
+    assert case_id(0.00025, 1.3, "lind") == "dp0.25mm_ch1.3_lind"
+    assert case_id(0.1 + 0.2, 1.8000000000000003, "skillen") == "dp300mm_ch1.8_skillen"
+    import re
+    assert re.fullmatch(CASE_ID, case_id(0.00025, 2.2, "skillen", "coarse-start"))
+    assert not re.fullmatch(CASE_ID, "dp1e-3mm_ch1.8_lind")
+
+
+def test_grid_product_paper_and_extra_cases():
+    g = {"dp": [0.001, 0.0005], "ch": [1.0, 1.8], "shifting": ["skillen", "lind"]}
+    assert len(expand(g)) == 8
+    paper = expand({**g, "combine": "paper", "paper_ch": 1.8})
+    assert {c.id for c in paper} == {"dp1mm_ch1_skillen", "dp1mm_ch1.8_skillen", "dp1mm_ch1.8_lind",
+                                     "dp0.5mm_ch1_skillen", "dp0.5mm_ch1.8_skillen", "dp0.5mm_ch1.8_lind"}
+    extra = expand(g, [{"dp": 0.002, "ch": 1.5, "shifting": "none", "tag": "x"}])
+    assert extra[-1].id == "dp2mm_ch1.5_none_x" and not extra[-1].on_grid
+    with pytest.raises(ValueError, match="duplicate"):
+        expand(g, [{"dp": 0.001, "ch": 1.0, "shifting": "lind"}])
+
+
+def test_configs_validate_and_expand():
+    default = cfgmod.validate(load("config.yaml"))
+    assert len(cfgmod.cases(default)) == 30  # 3 dp x 5 Ch x 2 shifting
+    paper = cfgmod.validate(load("paper.yaml"))
+    cs = cfgmod.cases(paper)
+    assert len(cs) == 18
+    assert {c.dp for c in cs} == {0.001, 0.0005, 0.00025}
+    assert {c.ch for c in cs} == {1.0, 1.3, 1.5, 1.8, 2.2}
+    assert {c.ch for c in cs if c.shifting == "lind"} == {1.8}
+
+
+@pytest.mark.parametrize("change, key", [
+    ({"grid": {"dp": [0.001], "ch": [1.8], "shifting": ["magic"]}}, "grid.shifting.0"),
+    ({"grid": {"dp": [-1.0], "ch": [1.8], "shifting": ["lind"]}}, "grid.dp.0"),
+    ({"grid": {"dp": "fine", "ch": [1.8], "shifting": ["lind"]}}, "grid.dp"),
+    ({"figures": {"dpi": "high"}}, "figures.dpi"),
+    ({"metricz": {}}, "(top level)"),
+    ({"case": {"dp": 0.001}}, "case"),
+])
+def test_schema_errors_name_the_key(change, key):
+    c = load("config.yaml")
+    c.update(change)
+    with pytest.raises(cfgmod.ConfigError) as exc:
+        cfgmod.validate(c)
+    assert f"config key {key}:" in str(exc.value)
+
+
+def test_solver_level_errors_are_caught_before_jobs():
+    c = load("config.yaml")
+    c["case"]["steady"]["average"] = 0.1
+    with pytest.raises(cfgmod.ConfigError, match="case.steady.average"):
+        cfgmod.validate(c)
+
+
+# ---- reference and metrics ---------------------------------------------------------------
+def test_reference_stations():
+    ref = theory(np.array([0.0, 0.76, 1.5, 9.7]), [0.76, 1.5, 9.7], np.linspace(0, 1.3, 53), 15.3)
+    np.testing.assert_allclose(ref["station_depth"], [0.7379, 0.8516, 0.99866], atol=5e-5)
+    np.testing.assert_allclose(ref["surface"].values[1:], [0.7379, 0.8516, 0.99866], atol=5e-5)
+    u = ref["velocity"].sel(station=9.7)
+    # depth mean 1 and surface 1.5 of the semi-parabola
+    zs = ref["z_star"].values
+    ok = np.isfinite(u.values)
+    s = zs[ok].max() / float(ref["station_depth"].sel(station=9.7))
+    assert np.nanmax(u.values) == pytest.approx(3 * (s - s * s / 2), rel=1e-12)
+    assert np.nanmax(u.values) > 1.49  # the surface value 1.5, to the grid
+
+
+def synthetic_run(depth_err=0.0, front_velocity=0.0, surface_shift=0.0, u_scale=1.0, status="completed"):
+    hn, ub = 0.01876, 0.075
+    x = np.round(np.arange(0, 14.0001, 0.1), 10)
+    z = np.round(np.arange(0, 1.3001, 0.025), 10)
+    st = np.array([0.76, 1.5, 9.7])
+    ref = theory(x, st, z, 15.3)
+    run = xr.Dataset(
+        {"mean_surface_elevation": ("x_star", (ref["surface"].values + surface_shift) * hn),
+         "mean_uniform_depth": ((), hn * (1 + depth_err)),
+         "mean_velocity_star": (("station", "z_star"), u_scale * ref["velocity"].values),
+         "front_velocity": ((), front_velocity)},
+        coords={"x_star": x, "station": st, "z_star": z},
+        attrs={"status": status, "h_n_m": hn, "belt_speed_m_s": ub, "normalising_depth_m": 0.0186})
+    return run, theory(np.round(np.arange(0, 12.0001, 0.1), 10), st, z, 15.3)
+
+
+def test_metrics_zero_for_the_reference_itself():
+    run, ref = synthetic_run()
+    m = case_metrics(run, ref)
+    assert float(m.zeta_f) == 0 and float(m.zeta_h) == 0 and float(m.zeta_fs) < 1e-12
+    assert np.all(m.zeta_u.values < 1e-12)
+    assert float(m.zeta_h_paper) == pytest.approx(abs(0.01876 - 0.0186) / 0.0186)
+
+
+def test_metrics_recover_known_errors():
+    run, ref = synthetic_run(depth_err=0.03, front_velocity=-0.0015, surface_shift=0.02, u_scale=1.1)
+    m = case_metrics(run, ref)
+    assert float(m.zeta_f) == pytest.approx(0.02)
+    assert float(m.zeta_h) == pytest.approx(0.03)
+    assert float(m.zeta_fs) == pytest.approx(0.02, rel=1e-9)
+    # u* scaled by 1.1: rms of 0.1 u*_ref over the reference heights
+    u = ref["velocity"].sel(station=9.7).values
+    expect = math.sqrt(np.nanmean((0.1 * u) ** 2))
+    assert float(m.zeta_u.sel(station=9.7)) == pytest.approx(expect, rel=1e-9)
+
+
+def test_metrics_nan_for_diverged_run():
+    run, ref = synthetic_run(status="diverged")
+    m = case_metrics(run, ref)
+    assert np.isnan(float(m.zeta_f)) and np.all(np.isnan(m.zeta_u.values))
+
+
+def test_measured_csv(tmp_path):
+    p = tmp_path / "u.csv"
+    p.write_text("# station 9.7\nz_star,u_star\n0.0,0.0\n0.5,1.125\n0.9,1.485\n")
+    meas = read_velocity_csv(p)
+    run, ref = synthetic_run()
+    m = case_metrics(run, ref, measured={"surface": None, "velocity": {9.7: meas}})
+    assert float(m.zeta_u_measured.sel(station=9.7)) < 0.01  # the theory passes through these points
+    bad = tmp_path / "bad.csv"
+    bad.write_text("z,u\n0,0\n1,1\n")
+    with pytest.raises(ValueError, match="missing column"):
+        read_velocity_csv(bad)
+
+
+def test_rms_does_not_bridge_gaps():
+    ref = xr.DataArray(np.zeros(5), coords={"x": np.arange(5.0)}, dims="x")
+    num = xr.DataArray(np.array([1.0, np.nan, np.nan, 1.0, 1.0]), coords={"x": np.arange(5.0)}, dims="x")
+    assert rms_difference(ref, num, "x") == pytest.approx(1.0)
+
+
+# ---- workflow -------------------------------------------------------------------------------
+def dry_run(configfile, tmp_path):
+    p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-n",
+                        "--configfile", str(configfile), "--quiet", "rules"],
+                       cwd=tmp_path, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr + p.stdout
+    counts = {}
+    for line in p.stdout.splitlines():
+        parts = line.split()
+        if len(parts) == 2 and parts[1].isdigit():
+            counts[parts[0]] = int(parts[1])
+    return counts
+
+
+@pytest.mark.parametrize("name, n", [("config.yaml", 30), ("paper.yaml", 18)])
+def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
+    counts = dry_run(ROOT / "config" / name, tmp_path)
+    assert counts["run_case"] == n and counts["metrics"] == n and counts["case_file"] == n
+    assert counts["compile_kernels"] == 1 and counts["campaign"] == 1
+    assert counts["figures"] == 1 and counts["report_html"] == 1
+
+
+def test_snakemake_rejects_bad_config(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("grid: {dp: [0.001], ch: [1.8], shifting: [magic]}\n")
+    p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-n",
+                        "--configfile", str(bad)], cwd=tmp_path, capture_output=True, text=True)
+    assert p.returncode != 0 and "magic" in (p.stdout + p.stderr)
