@@ -129,14 +129,19 @@ class FrontMonitor:
         })
         ds["area_drift"] = (("time",), ds.enclosed_area.values / ds.mass_area.values - 1.0,
                             {"units": "1", "long_name": "enclosed / mass-implied area - 1"})
-        steady_found = np.isfinite(self.t_steady)
+        steady_found = bool(np.isfinite(self.t_steady))
         ds.attrs["steady_state_time_s"] = float(self.t_steady)
-        if steady_found:
-            win = (t >= self.t_steady - 1e-9) & (t <= self.t_steady + c.steady.average + 1e-9)
+        ds.attrs["steady"] = int(steady_found)
+        # the steady window; without steady state, the final window of the same length,
+        # flagged (attrs steady = 0, averaging) so that nothing passes for a steady result
+        start = self.t_steady if steady_found else (t[-1] - c.steady.average if t.size else np.nan)
+        ds.attrs["averaging"] = "steady window" if steady_found else "final window, NOT steady"
+        if t.size and t[-1] - t[0] >= c.steady.average - 1e-9:
+            win = (t >= start - 1e-9) & (t <= start + c.steady.average + 1e-9)
             tw = t[win]
             avg = ds.isel(time=win).mean("time")
             for k in ("surface_elevation", "velocity_star", "uniform_depth", "number_density", "area_drift"):
-                ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name="steady-window mean of " + ds[k].attrs["long_name"])
+                ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name=ds.attrs["averaging"] + " mean of " + ds[k].attrs["long_name"])
             d = steady.drifts(tw, ds.toe_position.values[win], ds.uniform_depth.values[win],
                               self.station_means()[win], tw[-1] - tw[0])
             last_second = tw >= tw[-1] - 1.0 - 1e-9

@@ -57,6 +57,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     data["mean_velocity"] = arr(stations.size, z_star.size)
     data["front_x"] = arr(front_particles)
     data["front_z"] = arr(front_particles)
+    steady = np.zeros(shape)
     status = np.full(shape, "missing", dtype=object)
     reason = np.full(shape, "", dtype=object)
     case_ids = np.full(shape, "", dtype=object)
@@ -76,6 +77,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
             data["mean_velocity"][ix] = run["mean_velocity_star"].values
         data["front_x"][ix], data["front_z"][ix] = _front_particles(run, front_particles)
         status[ix], reason[ix], case_ids[ix] = run.attrs["status"], run.attrs["reason"], c.id
+        steady[ix] = float(m["steady"])
 
     dims = ("dp", "ch", "shifting")
     ds = xr.Dataset(
@@ -86,6 +88,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
          "mean_velocity": (dims + ("station", "z_star"), data["mean_velocity"]),
          "front_x": (dims + ("front_particle",), data["front_x"]),
          "front_z": (dims + ("front_particle",), data["front_z"]),
+         "steady": (dims, steady, {"units": "1", "long_name": "1: metrics from a steady window"}),
          "status": (dims, status.astype(str)),
          "reason": (dims, reason.astype(str)),
          "case_id": (dims, case_ids.astype(str))},
@@ -112,6 +115,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["case_shifting"] = ("case", [c.shifting for c in cases])
     ds["case_on_grid"] = ("case", [int(c.on_grid) for c in cases])
     ds["case_status"] = ("case", [r.attrs["status"] for r in runs])
+    ds["case_steady"] = ("case", [int(m["steady"]) for m in metrics])
     ds["case_reason"] = ("case", [r.attrs["reason"] for r in runs])
     for k, (attr, units, long) in RUN_NUMBERS.items():
         ds[f"case_{k}"] = ("case", [float(r.attrs.get(attr, np.nan)) for r in runs], {"units": units})

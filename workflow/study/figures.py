@@ -32,22 +32,42 @@ def _dp_mm(ds):
     return ds["dp"].values * 1000.0
 
 
+def _log_axes(ax, any_data: bool):
+    """Log axes when something was drawn; otherwise say there is nothing to draw."""
+    if any_data:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    else:
+        ax.text(0.5, 0.5, "no run gave this metric\n(diverged)", transform=ax.transAxes,
+                ha="center", va="center", color="0.4")
+    ax.set_xlabel("particle spacing dp [mm]")
+    if any_data:
+        ax.invert_xaxis()
+
+
+def _points(ax, x, y, steady, k, label):
+    """Filled markers: steady window; hollow: final window of a run that was not steady."""
+    ok = np.isfinite(y) & (y > 0)
+    c, m = COLOURS[k % 8], MARKERS[k % 8]
+    if ok.any():
+        ax.plot(x[ok], y[ok], color=c, lw=1, alpha=0.6)
+        st = ok & (steady > 0)
+        un = ok & ~(steady > 0)
+        ax.plot(x[st], y[st], ls="none", marker=m, color=c, label=label)
+        ax.plot(x[un], y[un], ls="none", marker=m, mfc="none", color=c,
+                label=None if st.any() else label)
+    return bool(ok.any())
+
+
 def _error_vs_dp(ax, ds, var, shifting, label_ch=True, station=None):
+    drawn = False
     for k, ch in enumerate(ds["ch"].values):
         y = ds[var].sel(ch=ch, shifting=shifting)
         if station is not None:
             y = y.sel(station=station)
-        y = y.values
-        ok = np.isfinite(y) & (y > 0)
-        ax.plot(_dp_mm(ds)[ok], y[ok], marker=MARKERS[k % 8], color=COLOURS[k % 8],
-                label=f"Ch = {ch:g}" if label_ch else None)
-        bad = ~np.isfinite(y)
-        for x in _dp_mm(ds)[bad]:
-            ax.axvline(x, color=COLOURS[k % 8], alpha=0.15, lw=4)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("particle spacing dp [mm]")
-    ax.invert_xaxis()
+        steady = ds["steady"].sel(ch=ch, shifting=shifting).values
+        drawn |= _points(ax, _dp_mm(ds), y.values, steady, k, f"Ch = {ch:g}" if label_ch else None)
+    _log_axes(ax, drawn)
 
 
 def _metric_figure(ds, var, ylabel, name, title, caption):
@@ -59,7 +79,11 @@ def _metric_figure(ds, var, ylabel, name, title, caption):
     axs[0][0].set_ylabel(ylabel)
     axs[0][-1].legend(fontsize=8)
     fig.tight_layout()
-    return Figure(name, title, caption, fig)
+    return Figure(name, title, caption + HOLLOW, fig)
+
+
+HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over the final window "
+          "of a run that did not reach steady state (read them as indicative only).")
 
 
 def fig_velocity_profiles(ds, ch, slope_deg):
@@ -118,22 +142,19 @@ def fig_shifting_comparison(ds, var, ch, name, title, ylabel, caption, station_p
     panels = list(ds["station"].values) if station_panels else [None]
     fig, axs = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.5), squeeze=False)
     for ax, s in zip(axs[0], panels):
+        drawn = False
         for k, sh in enumerate(sub["shifting"].values):
             y = sub[var].sel(shifting=sh)
             if s is not None:
                 y = y.sel(station=s)
-            ok = np.isfinite(y.values) & (y.values > 0)
-            ax.plot(_dp_mm(sub)[ok], y.values[ok], marker=MARKERS[k], color=COLOURS[k], label=sh)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.invert_xaxis()
-        ax.set_xlabel("particle spacing dp [mm]")
+            drawn |= _points(ax, _dp_mm(sub), y.values, sub["steady"].sel(shifting=sh).values, k, sh)
+        _log_axes(ax, drawn)
         ax.set_ylabel(ylabel)
         if s is not None:
             ax.set_title(f"x* = {s:g}")
     axs[0][-1].legend()
     fig.tight_layout()
-    return Figure(name, title, caption, fig)
+    return Figure(name, title, caption + HOLLOW, fig)
 
 
 def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3) -> list[Figure]:
@@ -141,8 +162,7 @@ def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3
         figs = [
             _metric_figure(ds, "zeta_f", "zeta_f", "fig02_zeta_f", "Fig. 2 - front velocity error",
                            "Front velocity error zeta_f = |u*_f - u*_b| / u*_b against dp for each Ch "
-                           "(one panel per shifting method; shaded columns: diverged or unsteady "
-                           "runs). The paper found zeta_f below a few per cent, decreasing with dp, "
+                           "(one panel per shifting method). The paper found zeta_f below a few per cent, decreasing with dp, "
                            "with the smallest Ch the least accurate."),
             _metric_figure(ds, "zeta_h", "zeta_h", "fig03_zeta_h", "Fig. 3 - uniform depth error",
                            "Uniform-zone depth error zeta_h (against the computed h_n) against dp for "
@@ -167,7 +187,7 @@ def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3
         figs.append(Figure("fig06_zeta_u", "Fig. 6 - velocity-profile errors",
                            "RMS velocity-profile error zeta_u,j at each station against dp for each "
                            "Ch. The paper found the errors largest near the toe (x* = 0.76) and "
-                           "smallest in the uniform zone (x* = 9.7).", fig))
+                           "smallest in the uniform zone (x* = 9.7)." + HOLLOW, fig))
         figs.append(fig_front_particles(ds, profile_ch))
         figs.append(fig_shifting_comparison(
             ds, "zeta_u", profile_ch, "fig08_shifting_zeta_u", "Fig. 8 - shifting: velocity errors",

@@ -55,14 +55,15 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
                  measured: dict | None = None) -> xr.Dataset:
     """All metrics of one run against the reference (and measured data when given).
 
-    Diverged or not-steady runs give NaN metrics, never numbers from a bad window.
+    Diverged runs give NaN metrics. A run that did not reach steady state gives its metrics
+    over its final window, flagged by ``steady = 0`` (the report and figures mark them).
     """
     st = ref["station"].values
     out = {k: np.nan for k in ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs")}
     zu = np.full(st.size, np.nan)
     meas = {"zeta_fs_measured": np.nan}
     zu_meas = np.full(st.size, np.nan)
-    ok = run.attrs.get("status") == "completed" and "mean_surface_elevation" in run
+    ok = run.attrs.get("status") in ("completed", "not_steady") and "mean_surface_elevation" in run
     if ok:
         hn = float(run.attrs["h_n_m"])
         ub = float(run.attrs["belt_speed_m_s"])
@@ -87,7 +88,9 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     data = {k: ((), v) for k, v in {**out, **meas}.items()}
     data["zeta_u"] = (("station",), zu)
     data["zeta_u_measured"] = (("station",), zu_meas)
+    data["steady"] = ((), int(run.attrs.get("steady", 0)) if ok else 0)
     ds = xr.Dataset(data, coords={"station": st})
+    ds["steady"].attrs.update(units="1", long_name="1: metrics over a steady window; 0: not steady or no metrics")
     attrs = {
         "zeta_f": "front velocity error |u*_f - u*_b| / u*_b",
         "zeta_h": "uniform depth error against the computed h_n",

@@ -47,7 +47,7 @@ def _commit() -> str:
 
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
-    head = ["case", "status", "wall time [s]", "steps", "particles", "steady at [s]",
+    head = ["case", "status", "steady", "wall time [s]", "steps", "particles", "steady at [s]",
             "zeta_f", "zeta_h (h_n)", "zeta_h (paper)", "zeta_fs"] + [f"zeta_u x*={s:g}" for s in st]
     rows = []
     for i, cid in enumerate(ds["case"].values):
@@ -55,7 +55,8 @@ def case_table(ds: xr.Dataset) -> str:
         reason = str(ds["case_reason"].values[i])
         cells = [f'<td class="l">{html.escape(str(cid))}</td>',
                  f'<td class="l" title="{html.escape(reason)}">{html.escape(status)}'
-                 + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>"]
+                 + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>",
+                 f'<td>{"yes" if int(ds["case_steady"].values[i]) else "no"}</td>']
         for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time",
                   "case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
             cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
@@ -76,7 +77,10 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     summary = (f"<p>{n} cases: " + ", ".join(f"{v} {html.escape(k)}" for k, v in counts.items())
                + f". Total simulation wall time {wall:.0f} s.</p>"
                + "<p>Metrics (SPEC section 4) are computed against lubrication theory over the "
-               "steady averaging window of each run; diverged and unsteady runs have no metrics. "
+               "steady averaging window of each run. A run that did not reach steady state by its "
+               "maximum time is shown with its metrics over its final window, marked "
+               "<b>steady: no</b> (hollow markers in the figures): indicative only. Diverged runs "
+               "have no metrics. "
                f"zeta_h is given against the computed normal depth h_n = "
                f"{_fmt(ds.attrs.get('h_n_m', np.nan) * 1000, 4)} mm and against the paper's "
                f"normalising depth {_fmt(ds.attrs.get('normalising_depth_m', np.nan) * 1000, 4)} mm.</p>")
