@@ -13,7 +13,7 @@ import xarray as xr
 
 from . import steady
 from .conveyor import ConveyorCase, build_scene
-from .output import to_dataset, versions, write_atomic
+from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, toe_position
 from .run import Runner
 from .simulation import Simulation
@@ -247,5 +247,3 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         ckpt.remove()
     return ds
 
-
-__all__ = ["FrontMonitor", "run_front", "versions", "write_atomic"]

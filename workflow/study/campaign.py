@@ -72,7 +72,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
         data["zeta_u_measured"][ix] = m["zeta_u_measured"].values
         for k, (attr, _, _) in RUN_NUMBERS.items():
             data[k][ix] = float(run.attrs.get(attr, np.nan))
-        if "mean_surface_elevation" in run:
+        if "mean_surface_elevation" in run and run.attrs["status"] != "diverged":
             data["mean_surface"][ix] = run["mean_surface_elevation"].values / run.attrs["h_n_m"]
             data["mean_velocity"][ix] = run["mean_velocity_star"].values
         data["front_x"][ix], data["front_z"][ix] = _front_particles(run, front_particles)
