@@ -18,6 +18,8 @@ import math
 import numba as nb
 import numpy as np
 
+from .cells import neighbour_cell
+
 from .kernel import grad_factor, w_value
 
 DET_MIN = 1.0e-3  # on the matrix made dimensionless with h
@@ -85,23 +87,10 @@ def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_act
         su = sw = 0.0
         bu1 = bu2 = bw1 = bw2 = 0.0
         for ddx in range(-1, 2):
-            jx = ix + ddx
-            shift = 0.0
-            if jx < 0:
-                if not periodic:
-                    continue
-                jx += ncx
-                shift = -period
-            elif jx >= ncx:
-                if not periodic:
-                    continue
-                jx -= ncx
-                shift = period
             for ddz in range(-1, 2):
-                jz = iz + ddz
-                if jz < 0 or jz >= ncz:
+                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                if c < 0:
                     continue
-                c = jx * ncz + jz
                 for j in range(start[c], start[c + 1]):
                     if kind[j] != 0:
                         continue

@@ -40,6 +40,23 @@ class Grid:
         return cls(x0, z0, csx, reach, max(ncx, 1), ncz, periodic, (x1 - x0) if periodic else 0.0)
 
 
+@nb.njit(inline="always", cache=True)
+def neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period):
+    """(cell id, x shift to add to its particles) of cell (ix + ddx, iz + ddz), wrapping in x
+    when periodic; cell -1 when outside the grid."""
+    jx = ix + ddx
+    jz = iz + ddz
+    shift = 0.0
+    if jz < 0 or jz >= ncz:
+        return -1, shift
+    if jx < 0 or jx >= ncx:
+        if not periodic:
+            return -1, shift
+        shift = -period if jx < 0 else period
+        jx = jx + ncx if jx < 0 else jx - ncx
+    return jx * ncz + jz, shift
+
+
 @nb.njit(cache=True)
 def assign_cells(x, z, kind, x0, z0, csx, csz, ncx, ncz, cell):
     """Write each particle's cell (sentinel ncx*ncz for idle boundary particles).

@@ -21,6 +21,8 @@ import math
 import numba as nb
 import numpy as np
 
+from .cells import neighbour_cell
+
 from .kernel import w_value
 
 C_SURFACE = 0.5
@@ -37,18 +39,10 @@ def _sums(px, pz, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz, ncx, ncz
     iz = int(math.floor((pz - z0) / csz))
     four_h2 = 4.0 * h * h
     for ddx in range(-1, 2):
-        jx = ix + ddx
-        shift = 0.0
-        if jx < 0 or jx >= ncx:
-            if not periodic:
-                continue
-            shift = -period if jx < 0 else period
-            jx = jx + ncx if jx < 0 else jx - ncx
         for ddz in range(-1, 2):
-            jz = iz + ddz
-            if jz < 0 or jz >= ncz:
+            c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+            if c < 0:
                 continue
-            c = jx * ncz + jz
             for j in range(start[c], start[c + 1]):
                 dx = px - (x[j] + shift)
                 dz = pz - z[j]

@@ -25,6 +25,8 @@ import math
 import numba as nb
 import numpy as np
 
+from .cells import neighbour_cell
+
 
 def wall_proximity_at_half_dp(h: float, dp: float) -> float:
     """|sum_b -F(r_ab) n_b| for a particle dp/2 from a flat wall of lattice particles: the
@@ -99,18 +101,10 @@ def free_surface(x, z, kind, gcx, gcz, divr, start, n_active, ncx, ncz, periodic
         iz = int(math.floor((z[i] - z0) / csz))
         occupied = False
         for ddx in range(-1, 2):
-            jx = ix + ddx
-            shift = 0.0
-            if jx < 0 or jx >= ncx:
-                if not periodic:
-                    continue
-                shift = -period if jx < 0 else period
-                jx = jx + ncx if jx < 0 else jx - ncx
             for ddz in range(-1, 2):
-                jz = iz + ddz
-                if jz < 0 or jz >= ncz:
+                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                if c < 0:
                     continue
-                c = jx * ncz + jz
                 for j in range(start[c], start[c + 1]):
                     if j == i:
                         continue
@@ -148,23 +142,10 @@ def lind_shift(x, z, kind, gcx, gcz, surface, wnx, wnz, s0, start, n_active, ncx
         iz = int(math.floor((z[i] - z0) / csz))
         near_surface = False
         for ddx in range(-1, 2):
-            jx = ix + ddx
-            shift = 0.0
-            if jx < 0:
-                if not periodic:
-                    continue
-                jx += ncx
-                shift = -period
-            elif jx >= ncx:
-                if not periodic:
-                    continue
-                jx -= ncx
-                shift = period
             for ddz in range(-1, 2):
-                jz = iz + ddz
-                if jz < 0 or jz >= ncz:
+                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                if c < 0:
                     continue
-                c = jx * ncz + jz
                 for j in range(start[c], start[c + 1]):
                     if not surface[j]:
                         continue
@@ -198,18 +179,10 @@ def shift_divergence(x, z, kind, mass, rho, sdx, sdz, start, n_active, ncx, ncz,
         iz = int(math.floor((z[i] - z0) / csz))
         s = 0.0
         for ddx in range(-1, 2):
-            jx = ix + ddx
-            shift = 0.0
-            if jx < 0 or jx >= ncx:
-                if not periodic:
-                    continue
-                shift = -period if jx < 0 else period
-                jx = jx + ncx if jx < 0 else jx - ncx
             for ddz in range(-1, 2):
-                jz = iz + ddz
-                if jz < 0 or jz >= ncz:
+                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                if c < 0:
                     continue
-                c = jx * ncz + jz
                 for j in range(start[c], start[c + 1]):
                     if j == i:
                         continue
