@@ -1,10 +1,7 @@
 """A running simulation: particle state kept sorted by cell, one step at a time."""
 from __future__ import annotations
 
-import math
-import sys
-import time as _time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numba as nb
 import numpy as np

@@ -3,7 +3,6 @@
 Three very coarse, short cases; one is forced to diverge (cfl = 5) and must be shown as such
 while the campaign completes. Then: changing a figure setting reruns no simulation.
 """
-import shutil
 import subprocess
 import sys
 from pathlib import Path

@@ -1,6 +1,5 @@
 """The conveyor-belt case: preset geometry, and a killed run resumed from its checkpoint."""
 import math
-import os
 import signal
 import subprocess
 import sys

@@ -1,5 +1,4 @@
 """Probes on synthetic particle fields with known answers (no time stepping)."""
-import math
 
 import numpy as np
 import pytest

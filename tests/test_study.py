@@ -1,6 +1,5 @@
 """The study: grid naming, config schema, reference, metrics on synthetic fields, workflow."""
 import math
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -11,8 +10,8 @@ import xarray as xr
 import yaml
 
 from study import config as cfgmod
-from study.grid import CASE_ID, Case, case_id, expand, fmt
-from study.metrics import case_metrics, rms_difference, zeta_f, zeta_h
+from study.grid import CASE_ID, case_id, expand, fmt
+from study.metrics import case_metrics, rms_difference
 from study.reference import read_velocity_csv, theory
 
 ROOT = Path(__file__).resolve().parent.parent
