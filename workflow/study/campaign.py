@@ -53,6 +53,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     data["zeta_u_measured"] = arr(stations.size)
     for k in RUN_NUMBERS:
         data[k] = arr()
+    data["uniform_depth"] = arr()
     data["mean_surface"] = arr(x_star.size)
     data["mean_velocity"] = arr(stations.size, z_star.size)
     data["front_x"] = arr(front_particles)
@@ -73,6 +74,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
         for k, (attr, _, _) in RUN_NUMBERS.items():
             data[k][ix] = float(run.attrs.get(attr, np.nan))
         if "mean_surface_elevation" in run and run.attrs["status"] != "diverged":
+            data["uniform_depth"][ix] = float(run["mean_uniform_depth"]) / run.attrs["h_n_m"]
             data["mean_surface"][ix] = run["mean_surface_elevation"].values / run.attrs["h_n_m"]
             data["mean_velocity"][ix] = run["mean_velocity_star"].values
         data["front_x"][ix], data["front_z"][ix] = _front_particles(run, front_particles)
@@ -84,6 +86,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
         {**{k: (dims, data[k]) for k in SCALARS + tuple(RUN_NUMBERS)},
          "zeta_u": (dims + ("station",), data["zeta_u"]),
          "zeta_u_measured": (dims + ("station",), data["zeta_u_measured"]),
+         "uniform_depth": (dims, data["uniform_depth"], {"units": "1", "long_name": "uniform depth h_u / h_n"}),
          "mean_surface": (dims + ("x_star",), data["mean_surface"]),
          "mean_velocity": (dims + ("station", "z_star"), data["mean_velocity"]),
          "front_x": (dims + ("front_particle",), data["front_x"]),

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-SECTIONS = ("Summary", "Configuration", "Cases", "Figures", "Provenance")
+SECTIONS = ("Summary", "Configuration", "Cases", "Convergence", "Figures", "Provenance")
 CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
@@ -67,6 +67,36 @@ def case_table(ds: xr.Dataset) -> str:
     return f"<table><tr>{th}</tr>{''.join(rows)}</table>"
 
 
+def convergence_table(ds: xr.Dataset) -> str:
+    """Observed order, Richardson-extrapolated value and GCI of the uniform depth h_u/h_n and
+    of the station depth-mean u*, for each Ch and shifting with three or more resolutions."""
+    from .convergence import gci
+    if ds.sizes["dp"] < 3:
+        return "<p>Fewer than three resolutions: no observed order or GCI.</p>"
+    st = ds["station"].values
+    rows = []
+    for sh in ds["shifting"].values:
+        for ch in ds["ch"].values:
+            sub = ds.sel(ch=ch, shifting=sh)
+            quantities = [("h_u / h_n", sub["uniform_depth"].values)]
+            with np.errstate(all="ignore"):
+                means = np.nanmean(sub["mean_velocity"].values, axis=2)
+            quantities += [(f"mean u* at x* = {s:g}", means[:, j]) for j, s in enumerate(st)]
+            for name, phi in quantities:
+                r = gci(sub["dp"].values, phi)
+                rows.append(f'<tr><td class="l">{html.escape(str(sh))}</td><td>{ch:g}</td>'
+                            f'<td class="l">{html.escape(name)}</td><td class="l">{r.status}</td>'
+                            f"<td>{_fmt(r.order)}</td><td>{_fmt(r.extrapolated, 4)}</td>"
+                            f"<td>{_fmt(r.gci_fine)}</td><td>{_fmt(r.error_fine)}</td></tr>")
+    head = ("<tr><th class='l'>shifting</th><th>Ch</th><th class='l'>quantity</th>"
+            "<th class='l'>sequence</th><th>observed order</th><th>extrapolated</th>"
+            "<th>GCI fine</th><th>finest vs extrapolated</th></tr>")
+    return ("<p>Grid Convergence Index (Celik et al. 2008) over the three finest resolutions; "
+            "oscillatory or divergent sequences are flagged and given no number. Runs that were "
+            "not steady enter with their final-window values.</p>"
+            f"<table>{head}{''.join(rows)}</table>")
+
+
 def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: str,
            extra_sections: list[tuple[str, str]] = ()) -> str:
     """HTML text; ``figures`` as (image path, title, caption); images are embedded."""
@@ -102,7 +132,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th><td class="l">{html.escape(str(v))}</td></tr>'
                                     for k, v in prov.items()) + "</table>"
     body = [("Summary", summary), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
-            ("Cases", case_table(ds)), *extra_sections,
+            ("Cases", case_table(ds)), ("Convergence", convergence_table(ds)), *extra_sections,
             ("Figures", "".join(figs)), ("Provenance", prov_html)]
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
