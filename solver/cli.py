@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
@@ -107,6 +108,8 @@ def _front(args) -> int:
     ckpt = None if args.no_checkpoint else (args.checkpoint or args.output + ".ckpt")
     ds = run_front(case, quiet=args.quiet, checkpoint=ckpt)
     write_atomic(ds, args.output)
+    if ckpt is not None and os.path.exists(ckpt):  # only once the result is on disk
+        os.remove(ckpt)
     msg = (f"{case.name}: {ds.attrs['status']} at t = {ds.attrs['simulated_time_s']:.3f} s, "
            f"{ds.attrs['steps']} steps, {ds.attrs['wall_time_s']:.1f} s wall")
     if ds.attrs["reason"]:

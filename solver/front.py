@@ -203,17 +203,13 @@ class Checkpointer:
         self.next = state["next_checkpoint"]
         return True
 
-    def remove(self):
-        if os.path.exists(self.path):
-            os.remove(self.path)
-
 
 def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dataset:
     """Run the case to steady state (or max_time) and return its dataset.
 
     With ``checkpoint`` (a path), the run resumes from a matching checkpoint there and
-    writes one every ``case.checkpoint_interval`` seconds of simulated time; the file is
-    removed when the run ends.
+    writes one every ``case.checkpoint_interval`` seconds of simulated time; the caller
+    removes it once the result is safely written.
     """
     scene = build_scene(case)
     monitor = FrontMonitor(case)
@@ -243,7 +239,5 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         "case_yaml": case.to_yaml(),
         "n_fluid": int(runner.sim.n_fluid), "n_boundary": int(runner.sim.n - runner.sim.n_fluid),
     })
-    if ckpt is not None:
-        ckpt.remove()
     return ds
 

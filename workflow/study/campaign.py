@@ -77,7 +77,8 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
             data["uniform_depth"][ix] = float(run["mean_uniform_depth"]) / run.attrs["h_n_m"]
             data["mean_surface"][ix] = run["mean_surface_elevation"].values / run.attrs["h_n_m"]
             data["mean_velocity"][ix] = run["mean_velocity_star"].values
-        data["front_x"][ix], data["front_z"][ix] = _front_particles(run, front_particles)
+        if run.attrs["status"] != "diverged":  # a diverged run keeps no final state
+            data["front_x"][ix], data["front_z"][ix] = _front_particles(run, front_particles)
         status[ix], reason[ix], case_ids[ix] = run.attrs["status"], run.attrs["reason"], c.id
         steady[ix] = float(m["steady"])
 
