@@ -49,10 +49,10 @@ def test_campaign_dataset(campaign):
 
 def test_report_has_every_section(campaign):
     html = (campaign / "reports" / "report.html").read_text()
-    for section in ("Summary", "Configuration", "Cases", "Convergence", "Figures", "Provenance"):
+    for section in ("Summary", "Configuration", "Cases", "Convergence", "Cost", "Figures", "Provenance"):
         assert f"<h2>{section}</h2>" in html
     assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
-    assert html.count("data:image/png;base64,") == 9
+    assert html.count("data:image/png;base64,") == 10
     assert "http://" not in html and "https://" not in html  # opens offline
 
 

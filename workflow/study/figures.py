@@ -32,17 +32,26 @@ def _dp_mm(ds):
     return ds["dp"].values * 1000.0
 
 
-def _log_axes(ax, any_data: bool):
-    """Log axes when something was drawn; otherwise say there is nothing to draw."""
+def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", invert_x: bool = True):
+    """Log axes when something was drawn (dp axes run coarse to fine, left to right);
+    otherwise say there is nothing to draw."""
     if any_data:
         ax.set_xscale("log")
         ax.set_yscale("log")
+        if invert_x:
+            ax.invert_xaxis()
     else:
         ax.text(0.5, 0.5, "no run gave this metric\n(diverged)", transform=ax.transAxes,
                 ha="center", va="center", color="0.4")
-    ax.set_xlabel("particle spacing dp [mm]")
-    if any_data:
-        ax.invert_xaxis()
+    ax.set_xlabel(xlabel)
+
+
+def _legend(axes, **kw):
+    """Legend on the first of ``axes`` that has labelled artists."""
+    for ax in axes:
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(**kw)
+            return
 
 
 def _points(ax, x, y, steady, k, label):
@@ -77,7 +86,7 @@ def _metric_figure(ds, var, ylabel, name, title, caption):
         _error_vs_dp(ax, ds, var, sh)
         ax.set_title(f"shifting: {sh}")
     axs[0][0].set_ylabel(ylabel)
-    axs[0][-1].legend(fontsize=8)
+    _legend(axs[0], fontsize=8)
     fig.tight_layout()
     return Figure(name, title, caption + HOLLOW, fig)
 
@@ -157,6 +166,49 @@ def fig_shifting_comparison(ds, var, ch, name, title, ylabel, caption, station_p
     return Figure(name, title, caption + HOLLOW, fig)
 
 
+COST_METRICS = (("zeta_f", None), ("zeta_h", None), ("zeta_fs", None), ("zeta_u", 9.7))
+
+
+def _flat(ds, var, station=None):
+    """(values, labels) of a (dp, ch, shifting) variable over every grid case."""
+    da = ds[var] if station is None else ds[var].sel(station=station, method="nearest")
+    vals, labels = [], []
+    for dp in ds["dp"].values:
+        for ch in ds["ch"].values:
+            for sh in ds["shifting"].values:
+                vals.append(float(da.sel(dp=dp, ch=ch, shifting=sh)))
+                labels.append(f"{dp * 1000:g} mm, Ch {ch:g}, {sh}")
+    return np.array(vals), labels
+
+
+def fig_cost_vs_error(ds):
+    from .pareto import pareto_front
+    cost, labels = _flat(ds, "wall_time")
+    fig, axs = plt.subplots(1, len(COST_METRICS), figsize=(4.2 * len(COST_METRICS), 3.8), squeeze=False)
+    shs = list(ds["shifting"].values)
+    for ax, (var, st) in zip(axs[0], COST_METRICS):
+        err, _ = _flat(ds, var, st)
+        ok = np.isfinite(err) & (err > 0) & np.isfinite(cost)
+        for k, sh in enumerate(shs):
+            m = ok & np.array([lab.endswith(sh) for lab in labels])
+            ax.plot(cost[m], err[m], ls="none", marker=MARKERS[k], color=COLOURS[k], label=sh, alpha=0.8)
+        front = pareto_front(np.where(ok, cost, np.nan), np.where(ok, err, np.nan))
+        order = np.argsort(cost[front])
+        ax.plot(cost[front][order], err[front][order], color="k", lw=1, drawstyle="steps-post",
+                label="Pareto front")
+        for i in np.where(front)[0]:
+            ax.annotate(labels[i], (cost[i], err[i]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        _log_axes(ax, bool(ok.any()), xlabel="wall time [s]", invert_x=False)
+        ax.set_ylabel(var if st is None else f"{var} (x* = {st:g})")
+    axs[0][0].legend(fontsize=8)
+    fig.tight_layout()
+    return Figure("fig11_cost_vs_error", "Run time against error",
+                  "Wall time of each case against each error metric (log-log), with the Pareto "
+                  "front (no case is both cheaper and more accurate) labelled by dp, Ch and "
+                  "shifting (steady and not-steady runs alike; the Cost table counts steady runs only). "
+                  "Not in the paper: it answers which run is the cheapest one to trust.", fig)
+
+
 def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3) -> list[Figure]:
     with plt.rc_context(STYLE):
         figs = [
@@ -182,7 +234,7 @@ def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3
                 _error_vs_dp(axs[i][j], ds, "zeta_u", sh, station=s)
                 axs[i][j].set_title(f"x* = {s:g}, {sh}")
             axs[i][0].set_ylabel("zeta_u")
-        axs[0][-1].legend(fontsize=8)
+        _legend(axs.ravel(), fontsize=8)
         fig.tight_layout()
         figs.append(Figure("fig06_zeta_u", "Fig. 6 - velocity-profile errors",
                            "RMS velocity-profile error zeta_u,j at each station against dp for each "
@@ -197,6 +249,7 @@ def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3
             ds, "zeta_f", profile_ch, "fig09_shifting_zeta_f", "Fig. 9 - shifting: front velocity",
             "zeta_f", "zeta_f for the two shifting methods at Ch = 1.8. The paper found the Lind "
             "shifting better for the front velocity."))
+        figs.append(fig_cost_vs_error(ds))
         figs.append(fig_shifting_comparison(
             ds, "zeta_h", profile_ch, "fig10_shifting_zeta_h", "Fig. 10 - shifting: uniform depth",
             "zeta_h", "zeta_h for the two shifting methods at Ch = 1.8. The paper found the Lind "

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-SECTIONS = ("Summary", "Configuration", "Cases", "Convergence", "Figures", "Provenance")
+SECTIONS = ("Summary", "Configuration", "Cases", "Convergence", "Cost", "Figures", "Provenance")
 CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
@@ -97,6 +97,26 @@ def convergence_table(ds: xr.Dataset) -> str:
             f"<table>{head}{''.join(rows)}</table>")
 
 
+def cheapest_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
+    """For each metric and threshold, the cheapest case (wall time) whose error meets it."""
+    from .pareto import cheapest_meeting
+    st = ds["station"].values
+    metrics = [(k, ds[f"case_{k}"].values) for k in ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs")]
+    metrics += [(f"zeta_u x*={s:g}", ds["case_zeta_u"].values[:, j]) for j, s in enumerate(st)]
+    cost = ds["case_wall_time"].values
+    steady = ds["case_steady"].values > 0
+    rows = []
+    for name, err in metrics:
+        for thr in thresholds:
+            i = cheapest_meeting(np.where(steady, cost, np.nan), err, thr)
+            case = "none" if i is None else f"{ds['case'].values[i]} ({cost[i]:.0f} s, {err[i]:.3g})"
+            rows.append(f'<tr><td class="l">{html.escape(name)}</td><td>{thr:g}</td>'
+                        f'<td class="l">{html.escape(case)}</td></tr>')
+    return ("<p>Cheapest steady case meeting each threshold (wall time, error).</p><table>"
+            "<tr><th class='l'>metric</th><th>threshold</th><th class='l'>cheapest case</th></tr>"
+            + "".join(rows) + "</table>")
+
+
 def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: str,
            extra_sections: list[tuple[str, str]] = ()) -> str:
     """HTML text; ``figures`` as (image path, title, caption); images are embedded."""
@@ -132,7 +152,8 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th><td class="l">{html.escape(str(v))}</td></tr>'
                                     for k, v in prov.items()) + "</table>"
     body = [("Summary", summary), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
-            ("Cases", case_table(ds)), ("Convergence", convergence_table(ds)), *extra_sections,
+            ("Cases", case_table(ds)), ("Convergence", convergence_table(ds)),
+            ("Cost", cheapest_table(ds)), *extra_sections,
             ("Figures", "".join(figs)), ("Provenance", prov_html)]
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
