@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, get_args, get_origin, get_type_hints
 
+import numpy as np
 import yaml
 
 SHIFTING_METHODS = ("none", "skillen", "lind")
@@ -57,7 +58,6 @@ class FluidProfile:
     velocity: tuple[float, float] = (0.0, 0.0)
 
     def top(self, x):
-        import numpy as np
         pts = np.asarray(self.surface, dtype=float)
         return np.interp(x, pts[:, 0], pts[:, 1])
 
@@ -67,7 +67,6 @@ class FluidProfile:
 
     @property
     def area(self) -> float:
-        import numpy as np
         xs = np.linspace(self.x[0], self.x[1], 2001)
         return float(np.trapezoid(np.maximum(self.top(xs) - self.base, 0.0), xs))
 
