@@ -91,14 +91,11 @@ def apply_overrides(data: dict, items) -> dict:
 
 
 def _front(args) -> int:
-    import yaml
     from .conveyor import case_from_dict
-    from .scene import SceneError
+    from .scene import SceneError, read_yaml
     try:
-        with open(args.case) as fh:
-            data = yaml.safe_load(fh) or {}
-        case = case_from_dict(apply_overrides(data, args.set))
-    except (SceneError, OSError, ValueError, yaml.YAMLError) as exc:
+        case = case_from_dict(apply_overrides(read_yaml(args.case) or {}, args.set))
+    except (SceneError, OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if not _set_threads(args.threads):

@@ -12,10 +12,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import yaml
 
 from . import lubrication
-from .scene import Scene, SceneError, parse_into, scene_from_dict
+from .scene import Scene, SceneError, YamlData, parse_into, read_yaml, scene_from_dict
 from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication")
@@ -54,7 +53,7 @@ class Belt:
 
 
 @dataclass
-class ConveyorCase:
+class ConveyorCase(YamlData):
     dp: float
     name: str = "conveyor"
     ch: float = 1.8
@@ -99,22 +98,10 @@ class ConveyorCase:
         return SteadyCriteria(window=s.window, front_velocity=s.front_velocity, depth=s.depth,
                               velocity=s.velocity, min_time=self.ramp_end + s.min_time)
 
-    def to_dict(self) -> dict:
-        from dataclasses import asdict
-        from .scene import _plain
-        return _plain(asdict(self))
-
-    def to_yaml(self) -> str:
-        return yaml.safe_dump(self.to_dict(), sort_keys=False)
 
 
 def load_case(path) -> ConveyorCase:
-    with open(path) as fh:
-        try:
-            data = yaml.safe_load(fh)
-        except yaml.YAMLError as exc:
-            raise SceneError(f"{path}: not valid YAML: {exc}") from None
-    return case_from_dict(data)
+    return case_from_dict(read_yaml(path))
 
 
 def case_from_dict(data) -> ConveyorCase:

@@ -147,8 +147,18 @@ class Domain(Rect):
     """Box that fluid particles must stay in; default: walls and fluid plus a margin."""
 
 
+class YamlData:
+    """to_dict / to_yaml for the validated dataclasses (scene, case)."""
+
+    def to_dict(self) -> dict:
+        return _plain(dataclasses.asdict(self))
+
+    def to_yaml(self) -> str:
+        return yaml.safe_dump(self.to_dict(), sort_keys=False)
+
+
 @dataclass
-class Scene:
+class Scene(YamlData):
     dp: float
     fluid: Fluid
     time: Time
@@ -198,23 +208,21 @@ class Scene:
              + sum(w.area for w in self.walls))
         return int(round(n / cell))
 
-    def to_dict(self) -> dict:
-        return _plain(dataclasses.asdict(self))
-
-    def to_yaml(self) -> str:
-        return yaml.safe_dump(self.to_dict(), sort_keys=False)
-
 
 # ---- reading and validation -------------------------------------------------
 
-def load_scene(path) -> Scene:
-    """Read a YAML scene file and validate it."""
+def read_yaml(path):
+    """Plain data of a YAML file; SceneError (naming the file) if it is not valid YAML."""
     with open(path) as fh:
         try:
-            data = yaml.safe_load(fh)
+            return yaml.safe_load(fh)
         except yaml.YAMLError as exc:
             raise SceneError(f"{path}: not valid YAML: {exc}") from None
-    return scene_from_dict(data)
+
+
+def load_scene(path) -> Scene:
+    """Read a YAML scene file and validate it."""
+    return scene_from_dict(read_yaml(path))
 
 
 def scene_from_dict(data: Any) -> Scene:
