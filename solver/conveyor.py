@@ -59,6 +59,7 @@ class ConveyorCase(YamlData):
     ch: float = 1.8
     shifting: str = "lind"
     shifting_coefficient: float | None = None
+    shift_density_correction: bool | None = None  # null: the method's default
     density: float = 1383.0
     viscosity: float = 5.6
     slope_deg: float = 15.3
@@ -209,6 +210,8 @@ def build_scene_dict(c: ConveyorCase) -> dict:
     shifting = {"method": c.shifting}
     if c.shifting_coefficient is not None:
         shifting["coefficient"] = c.shifting_coefficient
+    if c.shift_density_correction is not None:
+        shifting["density_correction"] = c.shift_density_correction
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,

@@ -60,3 +60,33 @@ def test_time_step_collapse():
     scene = example_scene("hydrostatic", guards={"min_dt_fraction": 0.99},
                           fluid={"blocks": [{"x": [0.0, 0.1], "z": [0.02, 0.05]}]})
     assert_clean_divergence(run(scene), "time step collapsed")
+
+
+def test_area_drift():
+    """The conveyor run's volume guard: fluid spread to 1.05 dp at unchanged density encloses
+    about 8 % more area than its mass implies (10 % for the particle rows, less the half
+    spacing at the surface and toe, which does not grow); the unspread lattice stays within
+    0.5 %."""
+    import yaml
+
+    from solver.conveyor import build_scene, case_from_dict
+    from solver.front import FrontMonitor
+    from solver.run import Runner
+    from tests.conftest import EXAMPLES
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        d = yaml.safe_load(fh)
+    d.update(dp=0.004, ch=1.5, start="block")
+    d["steady"].update(max_time=0.1)
+    case = case_from_dict(d)
+    scene = build_scene(case)
+    monitor = FrontMonitor(case)
+    assert monitor(Simulation(scene)) is None
+    assert abs(monitor.series["enclosed_area"][0] / monitor.series["mass_area"][0] - 1.0) < 0.005
+    parts = build_particles(scene)
+    f = parts.kind == 0
+    parts.x[f] *= 1.05
+    parts.z[f] *= 1.05
+    res = Runner(scene, Simulation(scene, parts), monitors=[FrontMonitor(case)]).run()
+    assert_clean_divergence(res, "enclosed area differs from the mass-implied area by +")
+    drift = float(res.reason.split("by +")[1].split(" %")[0])
+    assert 7.0 < drift < 10.0, res.reason

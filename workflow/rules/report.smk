@@ -1,6 +1,7 @@
 FIGURES = ["fig02_zeta_f", "fig03_zeta_h", "fig04_zeta_fs", "fig05_velocity_profiles",
            "fig06_zeta_u", "fig07_front_particles", "fig08_shifting_zeta_u",
-           "fig09_shifting_zeta_f", "fig10_shifting_zeta_h", "fig11_cost_vs_error"]
+           "fig09_shifting_zeta_f", "fig10_shifting_zeta_h", "fig11_cost_vs_error",
+           "fig12_stability_map"]
 FMT = config["figures"]["format"]
 
 

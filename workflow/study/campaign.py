@@ -3,8 +3,10 @@ grid, and a flat ``case`` table of every case (grid and extra)."""
 from __future__ import annotations
 
 import numpy as np
+import yaml
 import xarray as xr
 
+from . import stability
 from .grid import Case
 
 SCALARS = ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_fs_measured")
@@ -126,4 +128,16 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     for k in SCALARS:
         ds[f"case_{k}"] = ("case", [float(m[k]) for m in metrics])
     ds["case_zeta_u"] = (("case", "station"), np.stack([m["zeta_u"].values for m in metrics]))
+    # stability: margins to each guard, the detector that fired, the swept settings
+    marg = [stability.margins(r) for r in runs]
+    for k, long in (("density_margin", "max density deviation / its guard"),
+                    ("penetration_margin", "max wall penetration / its guard"),
+                    ("area_drift_margin", "max |area drift| / its guard"),
+                    ("energy_ratio", "peak kinetic energy / (0.5 M u_b^2)"),
+                    ("end_time", "simulated time at the end of the run")):
+        ds[f"case_{k}"] = ("case", [m[k] for m in marg], {"units": "s" if k == "end_time" else "1", "long_name": long})
+    ds["case_detector"] = ("case", [stability.detector(r.attrs["status"], r.attrs["reason"]) for r in runs])
+    ds["case_safe"] = ("case", [int(stability.is_safe(r.attrs["status"], m)) for r, m in zip(runs, marg)],
+                       {"long_name": f"survived with every margin below {stability.SAFE_FRACTION:g}"})
+    ds["case_settings"] = ("case", [yaml.safe_dump(stability.case_settings(r), sort_keys=False) for r in runs])
     return ds

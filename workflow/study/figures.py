@@ -209,6 +209,48 @@ def fig_cost_vs_error(ds):
                   "Not in the paper: it answers which run is the cheapest one to trust.", fig)
 
 
+def fig_stability_map(ds):
+    """One row per case: each guarded margin as a fraction of its guard, the peak kinetic
+    energy, and, for a diverged run, the detector that fired and when."""
+    from matplotlib.colors import ListedColormap
+    from .stability import MARGINS
+    cases = [str(c) for c in ds["case"].values]
+    n = len(cases)
+    vals = np.stack([ds[f"case_{k}"].values for k in MARGINS], axis=1) if "case_density_margin" in ds else np.full((n, 3), np.nan)
+    fig, ax = plt.subplots(figsize=(9.5, 0.9 + 0.28 * n))
+    cmap = ListedColormap(["#009E73", "#F0E442", "#E69F00", "#D55E00"])  # <0.25, <0.5, <1, >=1
+    level = np.digitize(np.nan_to_num(vals, nan=-1.0), [0.25, 0.5, 1.0]).astype(float)
+    level[~np.isfinite(vals)] = np.nan
+    ax.imshow(level, cmap=cmap, vmin=-0.5, vmax=3.5, aspect="auto", interpolation="nearest")
+    for i in range(n):
+        for j in range(vals.shape[1]):
+            ax.text(j, i, "-" if not np.isfinite(vals[i, j]) else f"{vals[i, j]:.2f}", ha="center",
+                    va="center", fontsize=7)
+        status = str(ds["case_status"].values[i]) if "case_status" in ds else ""
+        det = str(ds["case_detector"].values[i]) if "case_detector" in ds else ""
+        e = float(ds["case_energy_ratio"].values[i]) if "case_energy_ratio" in ds else np.nan
+        t = float(ds["case_end_time"].values[i]) if "case_end_time" in ds else np.nan
+        note = f"{e:.2g}" if np.isfinite(e) else "-"
+        note += f"   DIVERGED: {det}, t = {t:.2f} s" if status == "diverged" else f"   {status}, to {t:.2f} s"
+        ax.text(len(MARGINS) - 0.4, i, note, va="center", fontsize=7,
+                color=COLOURS[3] if status == "diverged" else "0.2")
+    ax.set_yticks(range(n), cases, fontsize=7)
+    ax.set_xticks(range(len(MARGINS)) , ["density\ndeviation", "wall\npenetration", "area\ndrift"], fontsize=8)
+    ax.set_xlim(-0.5, len(MARGINS) + 2.6)
+    ax.text(len(MARGINS) - 0.4, -0.9, "peak KE / (0.5 M u_b^2), outcome", fontsize=8)
+    ax.grid(False)
+    for sp in ax.spines.values():
+        sp.set_visible(False)
+    fig.tight_layout()
+    return Figure("fig12_stability_map", "Stability map",
+                  "Each case (row): the largest value reached by each guarded quantity as a "
+                  "fraction of its guard (green < 0.25, yellow < 0.5, orange < 1, vermillion: the "
+                  "guard fired), the peak kinetic energy in units of 0.5 M u_b^2 (about 1 for "
+                  "the belt flow), and the outcome: the detector that stopped a diverged run and "
+                  "when. Not in the paper: it shows where explicit SPH breaks on this flow and "
+                  "how close the survivors came.", fig)
+
+
 def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3) -> list[Figure]:
     with plt.rc_context(STYLE):
         figs = [
@@ -250,6 +292,7 @@ def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3
             "zeta_f", "zeta_f for the two shifting methods at Ch = 1.8. The paper found the Lind "
             "shifting better for the front velocity."))
         figs.append(fig_cost_vs_error(ds))
+        figs.append(fig_stability_map(ds))
         figs.append(fig_shifting_comparison(
             ds, "zeta_h", profile_ch, "fig10_shifting_zeta_h", "Fig. 10 - shifting: uniform depth",
             "zeta_h", "zeta_h for the two shifting methods at Ch = 1.8. The paper found the Lind "

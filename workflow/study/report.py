@@ -117,6 +117,47 @@ def cheapest_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
             + "".join(rows) + "</table>")
 
 
+def stability_section(ds: xr.Dataset) -> str:
+    """Counts, detectors, per-setting outcome and the recommended settings."""
+    from .stability import SAFE_FRACTION, recommended, settings_summary
+    if "case_detector" not in ds:
+        return "<p>No stability data in this campaign dataset.</p>"
+    status = [str(s) for s in ds["case_status"].values]
+    det = [str(d) for d in ds["case_detector"].values]
+    n, nd = len(status), status.count("diverged")
+    caught = sum(1 for s, d in zip(status, det) if s == "diverged" and d not in ("", "other"))
+    counts = {d: det.count(d) for d in sorted(set(det)) if d}
+    text = (f"<p>{n} combinations tried; {nd} diverged, {caught} of them stopped by a named "
+            "detector (" + (", ".join(f"{v} {html.escape(k)}" for k, v in counts.items()) or "none")
+            + f"); {n - nd} survived, {int(ds['case_safe'].values.sum())} of them <b>safe</b> (every "
+            f"guarded quantity below {SAFE_FRACTION:g} of its guard). Margins per case: Fig. 12.</p>")
+    rows = settings_summary(ds)
+    if rows:
+        def alone(r):
+            return "-" if r["alone"] is None else f"{r['alone'][0]} ({r['alone'][1]:.2f})"
+        text += ("<table><tr><th class='l'>setting</th><th class='l'>value</th><th>tried</th>"
+                 "<th>survived</th><th>safe</th><th class='l'>detectors that fired</th>"
+                 "<th class='l'>others at base: outcome (worst margin)</th></tr>"
+                 + "".join(f"<tr><td class='l'>{html.escape(r['setting'])}</td><td class='l'>{html.escape(r['value'])}</td>"
+                           f"<td>{r['tried']}</td><td>{r['survived']}</td><td>{r['safe']}</td>"
+                           f"<td class='l'>{html.escape(', '.join(r['detectors']))}</td>"
+                           f"<td class='l'>{html.escape(alone(r))}</td></tr>" for r in rows)
+                 + "</table>")
+    rec = recommended(ds)
+    if rec["settings"]:
+        base = ", ".join(f"{k} = {v}" for k, v in rec["base"].items())
+        items = "".join(
+            f"<li>{html.escape(k)}: survived {html.escape(', '.join(e['survived']) or 'none')}"
+            + (f"; diverged {html.escape(', '.join(e['diverged']))}" if e["diverged"] else "")
+            + (f"; recommended <b>{html.escape(e['best'])}</b> (largest margin)" if e["best"] else "")
+            + "</li>" for k, e in rec["settings"].items())
+        text += (f"<p><b>Recommended settings</b>, one setting at a time with the others at the base "
+                 f"({html.escape(base)}):</p><ul>{items}</ul>"
+                 + (f"<p>Largest margin among the safe cases: <b>{html.escape(rec['safest_case'])}</b>.</p>"
+                    if rec["safest_case"] else "<p>No case was safe.</p>"))
+    return text
+
+
 def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: str,
            extra_sections: list[tuple[str, str]] = ()) -> str:
     """HTML text; ``figures`` as (image path, title, caption); images are embedded."""
@@ -153,7 +194,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                                     for k, v in prov.items()) + "</table>"
     body = [("Summary", summary), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
             ("Cases", case_table(ds)), ("Convergence", convergence_table(ds)),
-            ("Cost", cheapest_table(ds)), *extra_sections,
+            ("Cost", cheapest_table(ds)), ("Stability", stability_section(ds)), *extra_sections,
             ("Figures", "".join(figs)), ("Provenance", prov_html)]
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
