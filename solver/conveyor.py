@@ -17,7 +17,7 @@ from . import lubrication
 from .scene import Scene, SceneError, YamlData, parse_into, read_yaml, scene_from_dict
 from .steady import SteadyCriteria
 
-START_SHAPES = ("block", "lubrication")
+START_SHAPES = ("block", "lubrication", "warm")
 
 
 @dataclass
@@ -40,6 +40,7 @@ class Steady:
     average: float = 2.0  # s: averaging window once steady
     max_time: float = 30.0  # s: give up (status not_steady) after this
     min_time: float = 0.5  # s after the end of the belt ramp before steadiness counts
+    stop: bool = True  # false: run to max_time and average its final window (fixed end time)
 
 
 @dataclass
@@ -60,6 +61,8 @@ class ConveyorCase(YamlData):
     shifting: str = "lind"
     shifting_coefficient: float | None = None
     shift_density_correction: bool | None = None  # null: the method's default
+    shift_correction_limit: float | None = None  # null: the method's default
+    shift_max: float | None = None  # clip of each shift component in dp; null: the scene default
     density: float = 1383.0
     viscosity: float = 5.6
     slope_deg: float = 15.3
@@ -67,6 +70,7 @@ class ConveyorCase(YamlData):
     belt: Belt = field(default_factory=Belt)
     fluid_length: float = 20.0  # in h_n, of the initial block (the lubrication start keeps its area)
     start: str = "lubrication"
+    warm_from: str | None = None  # start: warm: a front run's NetCDF (another dp) to start from
     wall_height: float = 2.5  # upstream wall, in h_n
     normalising_depth: float = 0.0186  # m: the paper's h_n used to normalise its data
     coefsound: float = 10.0
@@ -92,7 +96,8 @@ class ConveyorCase(YamlData):
 
     @property
     def ramp_end(self) -> float:
-        return self.belt.rest + self.belt.ramp
+        """End of the belt start-up (0 for a warm start: the belt is already running)."""
+        return 0.0 if self.start == "warm" else self.belt.rest + self.belt.ramp
 
     def criteria(self) -> SteadyCriteria:
         s = self.steady
@@ -124,6 +129,8 @@ def validate_case(c: ConveyorCase) -> None:
         raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
     if c.start not in START_SHAPES:
         raise SceneError(f"case.start: {c.start!r} is not one of {', '.join(START_SHAPES)}")
+    if c.start == "warm" and not c.warm_from:
+        raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")
     positive(c.belt.margin, "case.belt.margin")
     if c.belt.rest < 0 or c.belt.ramp < 0 or c.belt.taper_length < 0:
@@ -162,9 +169,11 @@ def wall_thickness(c: ConveyorCase) -> float:
     return math.ceil(2.0 * c.ch - 1e-9) * c.dp
 
 
-def initial_toe(c: ConveyorCase) -> float:
+def initial_toe(c: ConveyorCase, warm=None) -> float:
     """x of the toe at t = 0."""
     hn = c.h_n
+    if warm is not None:
+        return warm.toe
     if c.start == "block":
         return c.fluid_length * hn
     return (c.fluid_length + lubrication.front_area_deficit(c.theta)) * hn
@@ -185,11 +194,14 @@ def front_surface(c: ConveyorCase, n: int = 600) -> list[list[float]]:
     return [[float(a), float(b)] for a, b in zip(x, z)]
 
 
-def build_scene_dict(c: ConveyorCase) -> dict:
-    """The generic scene of SPEC section 2 as plain data."""
+def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
+    """The generic scene of SPEC section 2 as plain data. ``warm`` (a ``warm.WarmState``)
+    gives the free surface of a warm start; without it a warm case is built with the
+    lubrication shape (for validation before the run it starts from exists)."""
     hn, th, g = c.h_n, c.theta, c.gravity
     T = wall_thickness(c)
-    x_toe = initial_toe(c)
+    x_toe = initial_toe(c, warm)
+    rest, ramp = (0.0, 0.0) if c.start == "warm" else (c.belt.rest, c.belt.ramp)
     belt_end = c.dp * math.ceil((x_toe + c.belt.margin * hn) / c.dp)
     wall_top = c.dp * math.ceil(c.wall_height * hn / c.dp)
     # a belt running at full speed into the fixed wall is a corner singularity that squeezes
@@ -199,19 +211,22 @@ def build_scene_dict(c: ConveyorCase) -> dict:
     edges = [c.dp * round(k * c.belt.taper_length * hn / max(n, 1) / c.dp) for k in range(n + 1)]
     taper = [{"name": f"belt_taper{k}", "x": [edges[k], edges[k + 1]], "z": [-T, 0.0],
               "velocity": [-(k + 0.5) / n * c.belt.speed, 0.0], "moving": False,
-              "ramp_time": c.belt.ramp, "ramp_delay": c.belt.rest}
+              "ramp_time": ramp, "ramp_delay": rest}
              for k in range(n) if edges[k + 1] > edges[k]]
     belt_start = edges[-1] if n else 0.0
     if c.start == "block":
         fluid = {"blocks": [{"x": [0.0, x_toe], "z": [0.0, hn]}]}
     else:
+        surface = warm.surface() if warm is not None else front_surface(c)
         fluid = {"profiles": [{"x": [0.0, c.dp * math.floor(x_toe / c.dp)], "base": 0.0,
-                               "surface": front_surface(c)}]}
+                               "surface": surface}]}
     shifting = {"method": c.shifting}
     if c.shifting_coefficient is not None:
         shifting["coefficient"] = c.shifting_coefficient
-    if c.shift_density_correction is not None:
-        shifting["density_correction"] = c.shift_density_correction
+    for key, value in (("density_correction", c.shift_density_correction),
+                       ("correction_limit", c.shift_correction_limit), ("max_shift", c.shift_max)):
+        if value is not None:
+            shifting[key] = value
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,
@@ -219,7 +234,7 @@ def build_scene_dict(c: ConveyorCase) -> dict:
         "walls": [
             {"name": "belt", "x": [belt_start, belt_end], "z": [-T, 0.0],
              "velocity": [-c.belt.speed, 0.0], "moving": False,
-             "ramp_time": c.belt.ramp, "ramp_delay": c.belt.rest},
+             "ramp_time": ramp, "ramp_delay": rest},
             {"name": "upstream", "x": [-T, 0.0], "z": [-T, wall_top]},
         ] + taper,
         "gravity": [g * math.sin(th), -g * math.cos(th)],
@@ -233,5 +248,5 @@ def build_scene_dict(c: ConveyorCase) -> dict:
     }
 
 
-def build_scene(c: ConveyorCase) -> Scene:
-    return scene_from_dict(build_scene_dict(c))
+def build_scene(c: ConveyorCase, warm=None) -> Scene:
+    return scene_from_dict(build_scene_dict(c, warm))

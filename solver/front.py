@@ -95,7 +95,7 @@ class FrontMonitor:
             if steady.is_steady(self.t, self.series["toe"], self.series["uniform_depth"],
                                 self.station_means(), self.crit, c.belt.speed, c.h_n):
                 self.t_steady = sim.t
-        elif sim.t >= self.t_steady + c.steady.average - 1e-9:
+        elif c.steady.stop and sim.t >= self.t_steady + c.steady.average - 1e-9:
             return ("completed", "")
         return None
 
@@ -134,7 +134,13 @@ class FrontMonitor:
         ds.attrs["steady"] = int(steady_found)
         # the steady window; without steady state, the final window of the same length,
         # flagged (attrs steady = 0, averaging) so that nothing passes for a steady result
-        start = self.t_steady if steady_found else (t[-1] - c.steady.average if t.size else np.nan)
+        # with steady.stop false (fixed end time) the final window, steady when it starts after
+        # steady state was detected
+        final = t[-1] - c.steady.average if t.size else np.nan
+        if steady_found and not c.steady.stop:
+            steady_found = self.t_steady <= final + 1e-9
+            ds.attrs["steady"] = int(steady_found)
+        start = (self.t_steady if c.steady.stop else final) if steady_found else final
         ds.attrs["averaging"] = "steady window" if steady_found else "final window, NOT steady"
         if t.size and t[-1] - t[0] >= c.steady.average - 1e-9:
             win = (t >= start - 1e-9) & (t <= start + c.steady.average + 1e-9)
@@ -211,9 +217,20 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     writes one every ``case.checkpoint_interval`` seconds of simulated time; the caller
     removes it once the result is safely written.
     """
-    scene = build_scene(case)
+    if case.start == "warm":
+        from . import warm as _warm
+        from .build import build_particles
+        state = _warm.load(case.warm_from)
+        scene = build_scene(case, state)
+        parts = build_particles(scene)
+        f = parts.kind == 0
+        parts.u[f], parts.w[f] = state.velocity_at(parts.x[f], parts.z[f])
+        sim = Simulation(scene, parts)
+    else:
+        scene = build_scene(case)
+        sim = Simulation(scene)
     monitor = FrontMonitor(case)
-    runner = Runner(scene, Simulation(scene), monitors=[monitor], final_snapshot=True)
+    runner = Runner(scene, sim, monitors=[monitor], final_snapshot=True)
     ckpt = None
     resumed = False
     if checkpoint is not None:

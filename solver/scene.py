@@ -109,15 +109,22 @@ class Sound:
     depth: float | None = None
 
 
+# Lind moves particles by up to 0.1 dp every step; a density correction that followed each
+# such move in full would erase the compression the pressure needs (see docs/numerics.md)
+LIND_CORRECTION_LIMIT = 1.0e-3
+
+
 @dataclass
 class Shifting:
     method: str = "none"
     coefficient: float | None = None  # A (skillen, default 2) or A_L (lind, default 1)
     surface_threshold: float = 1.5  # div r below this marks the free surface
     max_shift: float = 0.1  # skillen: clip of each component, in units of dp
-    # rho *= 1 - div(dr): shifting keeps volume and density consistent; null = on for skillen,
-    # off for lind (whose per-step D = h^2/2 makes the coupling unstable)
+    # rho *= 1 - div(dr): shifting keeps volume and density consistent (null: on)
     density_correction: bool | None = None
+    # limit of |div(dr)| per step in that correction; null: the method's default (lind 1e-3,
+    # skillen none), 0 or a negative value is rejected
+    correction_limit: float | None = None
 
 
 @dataclass
@@ -193,7 +200,15 @@ class Scene(YamlData):
     @property
     def shift_density_correction(self) -> bool:
         s = self.physics.shifting
-        return s.density_correction if s.density_correction is not None else s.method == "skillen"
+        return s.density_correction if s.density_correction is not None else s.method != "none"
+
+    @property
+    def shift_correction_limit(self) -> float:
+        """Per-step limit of |div(dr)| in the density correction (inf: none)."""
+        s = self.physics.shifting
+        if s.correction_limit is not None:
+            return s.correction_limit
+        return LIND_CORRECTION_LIMIT if s.method == "lind" else math.inf
 
     @property
     def shifting_coefficient(self) -> float:
@@ -358,6 +373,8 @@ def validate(scene: Scene) -> None:
     if sh.coefficient is not None:
         _positive(sh.coefficient, "physics.shifting.coefficient")
     _positive(sh.max_shift, "physics.shifting.max_shift")
+    if sh.correction_limit is not None:
+        _positive(sh.correction_limit, "physics.shifting.correction_limit")
     if not 0 < sh.surface_threshold < 2:
         raise SceneError(
             f"physics.shifting.surface_threshold: must lie in (0, 2), got {sh.surface_threshold}")

@@ -5,14 +5,18 @@ skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - th
 lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp; no shift for
          particles within 2h of a free-surface particle (div r < thr, or a scan-region test
          where thr <= div r < 1.9, see free_surface).
-Density correction (default on for skillen, off for lind): shifting moves particles relative to the fluid, so each
+Density correction (default on): shifting moves particles relative to the fluid, so each
 particle's volume changes by V div(dr); with its mass fixed its density becomes
 rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab. Without it, shifting that
 spreads particles near a free surface inflates the fluid at constant density (measured on
-the periodic film: +2.1 % area in 1 s with skillen, +0.17 %/s with lind; with it +0.3 %
-and -0.06 %). With lind, whose per-step D = h^2/2 moves particles far faster than
-pressure can respond, the correction turns round-off into a growing density mode (measured:
-1e-13 to 5e-5 in 335 steps of a channel at rest), so it is off for lind by default.
+the periodic film: +2.1 % area in 1 s with skillen; on the paper case at dp = 1 mm with
+lind, +2 % of enclosed area by t = 2.1 s). Lind relocates particles by up to 0.1 dp every
+step, as fast as the flow compresses them: a correction that followed each relocation in
+full would reset the density and erase the compression the pressure needs (a channel at
+rest then grows round-off into a 10 % density error in 454 steps). For lind the correction
+of one step is therefore limited to |div(dr)| <= 1e-3 (``correction_limit``): the slow
+spreading it exists for (median |div(dr)| 6e-6 per step on the paper case) is corrected in
+full, the tail of fast relocations (0.02-0.1 % of particle-steps) is not.
 Near a wall (n = kernel-weighted sum sum_b -F_ab n_b of the inward normals of the wall
 particles in reach) the component of dr pointing into the wall is removed once the particle
 is as close as the lattice puts it (|n| at least its value dp/2 from a flat wall): shifting
@@ -197,3 +201,4 @@ def shift_divergence(x, z, kind, mass, rho, sdx, sdz, start, n_active, ncx, ncz,
                     ddz_ = sdz[j] - sdz[i]
                     s += mass[j] / rho[j] * F * (ddx_ * ex + ddz_ * ez)
         out[i] = s
+

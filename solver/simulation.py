@@ -1,6 +1,7 @@
 """A running simulation: particle state kept sorted by cell, one step at a time."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numba as nb
@@ -173,7 +174,11 @@ class Simulation:
                                       self.shift_dz, self.start, self.n_active, g.ncx, g.ncz,
                                       g.periodic, g.period, g.x0, g.z0, g.csx, g.csz, self.h,
                                       self.shift_div)
-            self.rho[:self.n_active] *= 1.0 - self.shift_div[:self.n_active]
+            div = self.shift_div[:self.n_active]
+            lim = self.scene.shift_correction_limit
+            if lim < math.inf:
+                np.clip(div, -lim, lim, out=div)
+            self.rho[:self.n_active] *= 1.0 - div
         self.x[:self.n_active] += self.shift_dx[:self.n_active]
         self.z[:self.n_active] += self.shift_dz[:self.n_active]
 
