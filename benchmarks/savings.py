@@ -16,7 +16,8 @@ with density diffusion compiled out (delta = 0) against compiled in with delta =
 without shifting against the shifting sums compiled in but unused.
 
 Usage: python benchmarks/savings.py [--dp 0.001] [--coarse-dp 0.002] [--shifting skillen]
-           [--threads 2] [--fixed-end 8] [--out results/savings] [--only default block ...]
+           [--threads 2] [--fixed-end 8] [--max-time 12] [--coarse-max-time 6]
+           [--out results/savings] [--only coarse default fixed_end block warm compiled]
 Runs already in --out are reused (delete them to rerun). Prints a Markdown table.
 """
 from __future__ import annotations
@@ -108,6 +109,8 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--fixed-end", type=float, default=8.0)
     ap.add_argument("--max-time", type=float, default=12.0)
+    ap.add_argument("--coarse-max-time", type=float, default=6.0,
+                    help="the coarse run's max_time (the default campaign's)")
     ap.add_argument("--out", default=str(ROOT / "results" / "savings"))
     ap.add_argument("--only", nargs="*", default=None)
     a = ap.parse_args(argv)
@@ -118,7 +121,7 @@ def main(argv=None):
     tag = f"{a.shifting}_dp{a.dp * 1000:g}mm"
     ctag = f"{a.shifting}_dp{a.coarse_dp * 1000:g}mm"
     plan = {
-        "coarse": (f"coarse_{ctag}", [coarse] + base),
+        "coarse": (f"coarse_{ctag}", [coarse] + base[:1] + [f"steady.max_time={a.coarse_max_time:g}"]),
         "default": (f"default_{tag}", [fine] + base),
         "fixed_end": (f"fixed_end_{tag}", [fine] + base[:1] + [f"steady.max_time={a.fixed_end:g}", "steady.stop=false"]),
         "block": (f"block_{tag}", [fine] + base + ["start=block"]),

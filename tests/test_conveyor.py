@@ -102,3 +102,47 @@ def test_killed_run_resumes_to_the_same_result(tmp_path):
     assert a.attrs["steps"] == b.attrs["steps"]
     for v in a.data_vars:
         np.testing.assert_array_equal(a[v].values, b[v].values, err_msg=v)
+
+
+def coarse_state(path, dp=4.0e-3, length=0.3, depth=0.04, status="not_steady"):
+    """A synthetic front run: a block of fluid particles with u = -0.075 + 5 z, w = 0.01."""
+    xs, zs = np.meshgrid(np.arange(0.5, round(length / dp)) * dp, np.arange(0.5, round(depth / dp)) * dp)
+    x, z = xs.ravel(), zs.ravel()
+    ds = xr.Dataset({"x": (("snapshot", "particle"), x[None]), "z": (("snapshot", "particle"), z[None]),
+                     "u": (("snapshot", "particle"), (-0.075 + 5.0 * z)[None]),
+                     "w": (("snapshot", "particle"), np.full((1, x.size), 0.01)),
+                     "kind": (("snapshot", "particle"), np.zeros((1, x.size), dtype=np.int8)),
+                     "toe_position": ("time", [length])},
+                    attrs={"dp": dp, "h": 1.5 * dp, "status": status, "reason": ""})
+    ds.to_netcdf(path)
+    return x.size * dp * dp
+
+
+def test_warm_start_fills_the_coarse_state(tmp_path):
+    area = coarse_state(tmp_path / "coarse.nc")
+    c = paper(start="warm", warm_from=str(tmp_path / "coarse.nc"), dp=2.0e-3, ch=1.5)
+    assert c.ramp_end == 0.0
+    from solver import warm
+    state = warm.load(c.warm_from)
+    scene = build_scene(c, state)
+    assert all(w.ramp_time == 0.0 and w.ramp_delay == 0.0 for w in scene.walls)
+    p = build_particles(scene)
+    f = p.kind == 0
+    # the fine lattice fills the coarse fluid's area, to half a fine dp per column
+    assert f.sum() * c.dp ** 2 == pytest.approx(area, abs=0.5 * c.dp * 0.3)
+    u, w = state.velocity_at(p.x[f], p.z[f])
+    inside = (p.z[f] > 2 * state.h) & (p.z[f] < 0.04 - 2 * state.h) & (p.x[f] > 2 * state.h) & (p.x[f] < 0.3 - 2 * state.h)
+    assert inside.sum() > 100
+    # Shepard interpolation of a linear field where the coarse kernel is full: exact up to
+    # the kernel's first moment off the lattice, held here to 0.5 % of a coarse dp
+    np.testing.assert_allclose(u[inside], -0.075 + 5.0 * p.z[f][inside], atol=5.0 * 0.005 * state.dp)
+    np.testing.assert_allclose(w, 0.01, atol=1e-12)
+
+
+def test_warm_start_errors(tmp_path):
+    with pytest.raises(SceneError, match="case.warm_from"):
+        paper(start="warm")
+    coarse_state(tmp_path / "bad.nc", status="diverged")
+    from solver import warm
+    with pytest.raises(ValueError, match="diverged"):
+        warm.load(tmp_path / "bad.nc")

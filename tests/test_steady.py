@@ -65,3 +65,37 @@ def test_window_must_be_filled_after_min_time():
     assert not ok(70)  # t = 1.38: the window would start before min_time = 0.5
     assert ok(80)  # t = 1.58
     assert not ok(80, SteadyCriteria(min_time=5.0))
+
+
+def test_fixed_end_time_averages_the_final_window():
+    """steady.stop: false: the run goes on to max_time and averages its final window, flagged
+    steady when that window starts after steady state was detected; with the stop, the
+    window starts at the detection."""
+    import yaml
+
+    from solver.conveyor import case_from_dict
+    from solver.front import FrontMonitor
+    from tests.conftest import EXAMPLES
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        d = yaml.safe_load(fh)
+    d.update(dp=0.004, ch=1.5)
+
+    def window(stop, t_steady):
+        d["steady"].update(stop=stop, max_time=4.0, average=2.0)
+        m = FrontMonitor(case_from_dict(d))
+        m.t = list(np.arange(0.0, 4.0 + 1e-9, 0.02))
+        depth = np.where(np.asarray(m.t) < 1.5, 0.010, 0.018)  # a step the window must see or not
+        m.series = {"toe": [0.4] * len(m.t), "uniform_depth": list(depth), "enclosed_area": [1.0] * len(m.t),
+                    "mass_area": [1.0] * len(m.t), "number_density": [1.0] * len(m.t)}
+        m.surface = [np.zeros(m.x_star.size)] * len(m.t)
+        m.velocity = [np.ones((m.stations.size, m.z_star.size))] * len(m.t)
+        m.t_steady = t_steady
+        ds = m.dataset()
+        return ds.attrs["steady"], float(ds["mean_uniform_depth"])
+
+    steady, depth = window(True, 1.0)  # window [1, 3]: a quarter of it before the step
+    assert steady == 1 and abs(depth - (0.25 * 0.010 + 0.75 * 0.018)) < 2e-4
+    steady, depth = window(False, 1.0)  # window [2, 4], after the detection
+    assert steady == 1 and abs(depth - 0.018) < 1e-12
+    steady, depth = window(False, 3.0)  # detected inside the final window: not steady
+    assert steady == 0 and abs(depth - 0.018) < 1e-12
