@@ -6,7 +6,9 @@ import hashlib
 import math
 import os
 import pickle
+import sys
 import tempfile
+from dataclasses import replace
 
 import numpy as np
 import xarray as xr
@@ -217,16 +219,26 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     writes one every ``case.checkpoint_interval`` seconds of simulated time; the caller
     removes it once the result is safely written.
     """
+    warm_note = ""
+    state = None
     if case.start == "warm":
         from . import warm as _warm
+        try:
+            state = _warm.load(case.warm_from)
+        except (OSError, ValueError) as exc:  # a diverged or missing source: start cold
+            warm_note = f"fallback to the lubrication start: {exc}"
+            if not quiet:
+                print(f"warning: warm start not possible, {warm_note}", file=sys.stderr)
+    if state is not None:
         from .build import build_particles
-        state = _warm.load(case.warm_from)
         scene = build_scene(case, state)
         parts = build_particles(scene)
         f = parts.kind == 0
         parts.u[f], parts.w[f] = state.velocity_at(parts.x[f], parts.z[f])
         sim = Simulation(scene, parts)
     else:
+        if warm_note:
+            case = replace(case, start="lubrication", warm_from=None)
         scene = build_scene(case)
         sim = Simulation(scene)
     monitor = FrontMonitor(case)
@@ -254,6 +266,7 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         "slope_deg": case.slope_deg, "ch": case.ch, "shifting": case.shifting,
         "simulated_time_s": float(runner.sim.t), "resumed_from_checkpoint": int(resumed),
         "case_yaml": case.to_yaml(),
+        "warm_start": warm_note or (f"from {case.warm_from}" if case.start == "warm" else "no"),
         "n_fluid": int(runner.sim.n_fluid), "n_boundary": int(runner.sim.n - runner.sim.n_fluid),
     })
     return ds

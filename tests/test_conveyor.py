@@ -146,3 +146,14 @@ def test_warm_start_errors(tmp_path):
     from solver import warm
     with pytest.raises(ValueError, match="diverged"):
         warm.load(tmp_path / "bad.nc")
+
+
+def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
+    from solver.front import run_front
+    coarse_state(tmp_path / "bad.nc", status="diverged")
+    c = paper(start="warm", warm_from=str(tmp_path / "bad.nc"), dp=4.0e-3, ch=1.5,
+              steady={"max_time": 0.05, "window": 0.02, "average": 1.0}, probes={"interval": 0.004})
+    ds = run_front(c)
+    assert ds.attrs["status"] == "not_steady"
+    assert ds.attrs["warm_start"].startswith("fallback to the lubrication start") and "diverged" in ds.attrs["warm_start"]
+    assert "start: lubrication" in ds.attrs["case_yaml"]

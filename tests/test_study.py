@@ -182,3 +182,30 @@ def test_snakemake_rejects_bad_config(tmp_path):
     p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-n",
                         "--configfile", str(bad)], cwd=tmp_path, capture_output=True, text=True)
     assert p.returncode != 0 and "magic" in (p.stdout + p.stderr)
+
+
+def test_warm_start_chains_each_case_to_the_next_coarser_dp(tmp_path):
+    from study.config import case_dict, cases, validate, warm_source
+    cfg = validate({"case": {}, "grid": {"dp": [0.003, 0.002, 0.0025], "ch": [1.5], "shifting": ["lind"]},
+                    "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}],
+                    "warm_start": True})
+    by_id = {c.id: c for c in cases(cfg)}
+    assert warm_source(cfg, by_id["dp3mm_ch1.5_lind"]) is None
+    assert warm_source(cfg, by_id["dp2.5mm_ch1.5_lind"]).id == "dp3mm_ch1.5_lind"
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_lind"]).id == "dp2.5mm_ch1.5_lind"
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_x"]) is None  # extra cases start cold
+    d = case_dict(cfg, by_id["dp2mm_ch1.5_lind"])
+    assert d["start"] == "warm" and d["warm_from"] == "results/cases/dp2.5mm_ch1.5_lind/run.nc"
+    assert "warm_from" not in case_dict({**cfg, "warm_start": False}, by_id["dp2mm_ch1.5_lind"])
+    # snakemake orders the runs: the dry run lists the coarse run before the fine one
+    configfile = tmp_path / "warm.yaml"
+    configfile.write_text(yaml.safe_dump({"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind"]},
+                                          "warm_start": True}))
+    p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-n", "--cores", "1",
+                        "--configfile", str(configfile), "--printshellcmds"],
+                       cwd=tmp_path, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr + p.stdout
+    out = p.stdout
+    coarse = out.index("front results/cases/dp3mm_ch1.5_lind/case.yaml")
+    fine = out.index("front results/cases/dp2mm_ch1.5_lind/case.yaml")
+    assert coarse < fine

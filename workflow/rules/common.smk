@@ -1,7 +1,7 @@
 # Config validation (schema, then what a schema cannot check) before any job starts,
 # and the case grid.
 import yaml
-from study.config import SCHEMA, validate as validate_campaign, cases as campaign_cases, case_dict
+from study.config import SCHEMA, validate as validate_campaign, cases as campaign_cases, case_dict, run_path, warm_source
 from study.grid import CASE_ID
 
 validate(config, str(SCHEMA))
@@ -28,6 +28,19 @@ def _write_if_changed(path, text):
 CONFIG_FILE = "results/campaign_config.yaml"
 _write_if_changed(CONFIG_FILE, yaml.safe_dump(config, sort_keys=False))
 
+def _solver_hash():
+    """Hash of the solver's sources: a param of every run, so a changed solver reruns them."""
+    import hashlib
+    import pathlib
+    import solver
+    h = hashlib.sha256()
+    for f in sorted(pathlib.Path(solver.__file__).parent.glob("*.py")):
+        h.update(f.name.encode() + f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+SOLVER_HASH = _solver_hash()
+
 wildcard_constraints:
     case=CASE_ID,
 
@@ -35,3 +48,9 @@ wildcard_constraints:
 def case_yaml(wildcards):
     """The solver case of one campaign case: a param, so only its own settings rerun it."""
     return yaml.safe_dump(case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=True)
+
+
+def warm_input(wildcards):
+    """The coarser case's run a warm-started case starts from (none without warm_start)."""
+    src = warm_source(config, CASE_BY_ID[wildcards.case])
+    return [run_path(src)] if src is not None else []

@@ -21,10 +21,13 @@ rule run_case:
     input:
         case="results/cases/{case}/case.yaml",
         kernels="results/.kernels_compiled",
+        warm=warm_input,
     output:
         "results/cases/{case}/run.nc",
     log:
         "results/logs/run_{case}.log",
+    params:
+        solver=SOLVER_HASH,
     threads: RES["threads"]
     resources:
         runtime=RES["runtime_min"],

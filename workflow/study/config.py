@@ -80,9 +80,27 @@ def _merge(base: dict, changes: dict) -> dict:
     return out
 
 
+def warm_source(cfg: dict, case: Case) -> Case | None:
+    """With ``warm_start``: the grid case at the next coarser dp with the same Ch and
+    shifting, whose final state starts this one; None for the coarsest and extra cases."""
+    if not cfg.get("warm_start") or not case.on_grid:
+        return None
+    coarser = [c for c in cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
+               and c.dp > case.dp]
+    return min(coarser, key=lambda c: c.dp) if coarser else None
+
+
+def run_path(case: Case) -> str:
+    """Where the campaign writes a case's run (relative to the working directory)."""
+    return f"results/cases/{case.id}/run.nc"
+
+
 def case_dict(cfg: dict, case: Case) -> dict:
     """The solver's case file (solver.conveyor) for one campaign case."""
     d = _merge(cfg["case"], case.overrides)
+    src = warm_source(cfg, case)
+    if src is not None:
+        d.update(start="warm", warm_from=run_path(src))
     d.update(name=case.id, dp=case.dp, ch=case.ch, shifting=case.shifting)
     d["normalising_depth"] = cfg["reference"]["normalising_depth"]
     probes = d.setdefault("probes", {})
