@@ -105,7 +105,6 @@ class ConveyorCase(YamlData):
                               velocity=s.velocity, min_time=self.ramp_end + s.min_time)
 
 
-
 def load_case(path) -> ConveyorCase:
     return case_from_dict(read_yaml(path))
 

@@ -49,10 +49,13 @@ def test_campaign_dataset(campaign):
 
 def test_report_has_every_section(campaign):
     html = (campaign / "reports" / "report.html").read_text()
-    for section in ("Summary", "Configuration", "Cases", "Convergence", "Cost", "Figures", "Provenance"):
+    for section in ("Summary", "Configuration", "Cases", "Convergence", "Cost", "Stability", "Figures",
+                    "Provenance"):
         assert f"<h2>{section}</h2>" in html
     assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
-    assert html.count("data:image/png;base64,") == 10
+    assert html.count("data:image/png;base64,") == 11  # Figs. 2-12
+    # the forced divergence is counted and named in the stability section and map
+    assert "1 diverged, 1 of them stopped by a named detector (1 density deviation)" in html
     assert "http://" not in html and "https://" not in html  # opens offline
 
 

@@ -1,5 +1,6 @@
 """Shifting (SPEC section 6): a uniform lattice stays put, a disordered one is ordered."""
 import math
+
 import numpy as np
 import pytest
 

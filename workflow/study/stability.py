@@ -30,7 +30,7 @@ GUARD_DEFAULTS = {"max_density_deviation": 0.1, "penetration": 0.5}
 MARGINS = ("density_margin", "penetration_margin", "area_drift_margin")
 TIE = 0.02  # worst margins closer than this are not told apart
 SAFE_FRACTION = 0.5  # a survivor is "safe" when every margin stays below this fraction
-SETTINGS = ("ch", "shifting", "shifting_coefficient", "cfl", "coefsound", "density_diffusion",
+SETTINGS = ("dp", "ch", "shifting", "shifting_coefficient", "cfl", "coefsound", "density_diffusion",
             "boundary")
 
 
