@@ -119,7 +119,7 @@ class Shifting:
     method: str = "none"
     coefficient: float | None = None  # A (skillen, default 2) or A_L (lind, default 1)
     surface_threshold: float = 1.5  # div r below this marks the free surface
-    max_shift: float = 0.1  # skillen: clip of each component, in units of dp
+    max_shift: float = 0.1  # clip of each shift component per step, in units of dp
     # rho *= 1 - div(dr): shifting keeps volume and density consistent (null: on)
     density_correction: bool | None = None
     # limit of |div(dr)| per step in that correction; null: the method's default (lind 1e-3,
