@@ -6,16 +6,19 @@ to a wall (negative gauge pressure, as in the corner of a belt running into a fi
 would otherwise be drawn through the wall by the symmetric pressure term.
 
 Each pair (a, b) is visited once and its contributions are added to both particles,
-into per-thread accumulators ``acc[t, q, i]`` (no write races), reduced afterwards.
-Quantities q: 0 ax, 1 az, 2 drho/dt, 3 gradC_x, 4 gradC_z, 5 div r, 6-7 the kernel-weighted
-sum of the inward normals of nearby wall particles (where shifting must not push).
-Density diffusion and the shifting sums are compiled in or out (``make_pair_loop``).
+into per-thread accumulators ``acc[t, i, q]`` (no write races; the slots of one particle
+share a cache line), reduced afterwards; a's sums stay in registers over the b loop.
+Slots q (named below): ax, az, drho/dt; with shifting gradC_x, gradC_z, div r and the
+kernel-weighted sum of the inward normals of nearby wall particles (where shifting must not
+push); with the shifting density correction, div(dr) of the previous step's shift.
+Density diffusion, the shifting sums and div(dr) are compiled in or out (``make_pair_loop``).
 
   drho_a/dt = rho_a sum_b u_ab.gradW_ab V_b + h c0 D_a
   D_a = 2 delta sum_b ((rho_a - rho_b) - rho_ab^H) (r_ab.gradW_ab) / (r^2 + eta^2) V_b
   du_a/dt = -sum_b m_b (P_a + P_b)/(rho_a rho_b) gradW_ab   (P_a + P_b >= 0 for fluid-wall pairs)
             + sum_b m_b 4 nu (r_ab.gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)) u_ab  (+ g)
   gradC_a = sum_b dp^2 gradW_ab,  div r_a = -sum_b dp^2 r_ab.gradW_ab
+  div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab   (dr: the last shift, zero for walls)
 In the two shifting sums every particle's volume is its lattice cell dp^2, not m/rho, so the
 concentration measures particle number density, which is what shifting evens out. With m/rho,
 a wall whose mDBC density follows the fluid pressure looks less concentrated than the fluid
@@ -32,43 +35,70 @@ import numpy as np
 
 from .kernel import grad_factor
 
-NQ = 8
-# Binomial series of (1 + x)^(1/7) - 1, split into even and odd powers: f(+-x) = E +- O.
-_C = [1.0]
-for _k in range(1, 12):
-    _C.append(_C[-1] * (1.0 / 7.0 - (_k - 1)) / _k)
-C1, C2, C3, C4, C5, C6, C7, C8, C9, C10, C11 = _C[1:]
+# Accumulator slots of the pair loop, acc[thread, particle, slot]
+AX, AZ, DRHO = 0, 1, 2                # acceleration, drho/dt
+GCX, GCZ, DIVR = 3, 4, 5              # shifting: gradC and div r
+WNX, WNZ = 6, 7                       # shifting: kernel-weighted inward wall normals
+DIVDR = 8                             # shifting density correction: div(dr) of the last shift
+NQ_BASE, NQ_SHIFT, NQ_CORRECTED = 3, 8, 9
+
+
+def n_slots(shifting: bool, shift_correction: bool) -> int:
+    return NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
+
+
+# Binomial series of (1 + x)^(1/7) - 1 to x^5, split into even and odd powers: f(+-x) = E +- O.
+C1 = 1.0 / 7.0
+C2 = C1 * (C1 - 1.0) / 2.0
+C3 = C2 * (C1 - 2.0) / 3.0
+C4 = C3 * (C1 - 3.0) / 4.0
+C5 = C4 * (C1 - 4.0) / 5.0
+SERIES_MAX = 0.02  # |x| below which the series is used: truncation error |C6| x^6 < 1.1e-12
+
+# No-NaN/no-infinity assumptions stay off, so that a diverging state still yields non-finite
+# values for the guards; contraction (FMA), reciprocals and reassociation are allowed.
+FASTMATH = {"contract", "arcp", "reassoc", "nsz"}
 
 
 @nb.njit(inline="always", cache=True)
 def hydrostatic_pair(x):
-    """((1 + x)^(1/7) - 1, (1 - x)^(1/7) - 1): series for |x| < 0.1 (error < 1e-13), pow beyond."""
-    if abs(x) < 0.1:
+    """((1 + x)^(1/7) - 1, (1 - x)^(1/7) - 1): series for |x| < SERIES_MAX (x is
+    rho0 g_n dz / B, about 0.01 for a pair 2h apart in the cases here), pow beyond."""
+    if abs(x) < SERIES_MAX:
         x2 = x * x
-        even = x2 * (C2 + x2 * (C4 + x2 * (C6 + x2 * (C8 + x2 * C10))))
-        odd = x * (C1 + x2 * (C3 + x2 * (C5 + x2 * (C7 + x2 * (C9 + x2 * C11)))))
+        even = x2 * (C2 + x2 * C4)
+        odd = x * (C1 + x2 * (C3 + x2 * C5))
         return even + odd, even - odd
     return (1.0 + x) ** (1.0 / 7.0) - 1.0, (1.0 - x) ** (1.0 / 7.0) - 1.0
 
 
 @functools.cache
-def make_pair_loop(diffusion: bool, shifting: bool):
-    """Compile the pair loop with density diffusion and shifting sums in or out."""
+def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False):
+    """Compile the pair loop with density diffusion, the shifting sums and the shift's
+    divergence (for the density correction) in or out."""
 
-    @nb.njit(parallel=True, cache=True, fastmath=False)
-    def pair_loop(x, z, u, w, rho, p, mass, kind, wnx, wnz, start, ncx, ncz, periodic, period, split,
-                  h, nu, hc0, rho0, k_hyd, delta, dp2, acc, vmax):
+    @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
+    def pair_loop(x, z, u, w, rho, p, mass, kind, wnx, wnz, sdx, sdz, start, ncx, ncz, periodic,
+                  period, split, h, nu, hc0, rho0, k_hyd, delta, dp2, acc, vmax):
         nt = split.size - 1
         fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
         eta2 = 0.01 * h * h
         four_h2 = 4.0 * h * h
         inv_h = 1.0 / h
-        acc[:] = 0.0
         for t in nb.prange(nt):
+            at = acc[t]
+            lo = start[split[t] * ncz]
+            hi = start[min(split[t + 1] + 1, ncx) * ncz]
+            at[lo:hi] = 0.0  # this thread writes its columns and the next one
+            if periodic and split[t + 1] == ncx:
+                at[0:start[ncz]] = 0.0
             vm = 0.0
             for ix in range(split[t], split[t + 1]):
                 for iz in range(ncz):
                     ca = ix * ncz + iz
+                    a0, a1 = start[ca], start[ca + 1]
+                    if a0 == a1:
+                        continue
                     for k in range(5):
                         # half stencil: self, (0,+1), (+1,-1), (+1,0), (+1,+1)
                         jx = ix if k < 2 else ix + 1
@@ -85,9 +115,16 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                         b0, b1 = start[cb], start[cb + 1]
                         if b0 == b1:
                             continue
-                        for a in range(start[ca], start[ca + 1]):
+                        for a in range(a0, a1):
                             xa, za, ua, wa = x[a], z[a], u[a], w[a]
                             ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
+                            Va = ma / ra
+                            ira = 1.0 / ra
+                            s_ax = s_az = s_drho = 0.0
+                            s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
+                            sxa = sza = 0.0
+                            if shift_correction:
+                                sxa, sza = sdx[a], sdz[a]
                             first = a + 1 if k == 0 else b0
                             for b in range(first, b1):
                                 kb = kind[b]
@@ -105,25 +142,25 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                                 vdotr = du * dx + dw * dz
                                 rdotg = F * r2
                                 mb = mass[b]
-                                Va = ma / ra
-                                Vb = mb / rb
+                                irb = 1.0 / rb
+                                Vb = mb * irb
                                 inv_r2e = 1.0 / (r2 + eta2)
                                 # continuity
                                 udotg = F * vdotr
-                                acc[t, 2, a] += ra * udotg * Vb
-                                acc[t, 2, b] += rb * udotg * Va
+                                s_drho += ra * udotg * Vb
+                                drho_b = rb * udotg * Va
                                 # pressure and laminar viscosity
                                 psum = pa + p[b]
                                 if ka + kb == 1 and psum < 0.0:
                                     psum = 0.0  # a wall pushes, never pulls
-                                pt = psum / (ra * rb) * F
+                                pt = psum * (ira * irb) * F
                                 vt = 4.0 * nu * rdotg / (ra + rb) * inv_r2e
                                 fx = -pt * dx + vt * du
                                 fz = -pt * dz + vt * dw
-                                acc[t, 0, a] += mb * fx
-                                acc[t, 1, a] += mb * fz
-                                acc[t, 0, b] -= ma * fx
-                                acc[t, 1, b] -= ma * fz
+                                s_ax += mb * fx
+                                s_az += mb * fz
+                                at[b, AX] -= ma * fx
+                                at[b, AZ] -= ma * fz
                                 vr = abs(h * vdotr * inv_r2e)
                                 if vr > vm:
                                     vm = vr
@@ -132,44 +169,71 @@ def make_pair_loop(diffusion: bool, shifting: bool):
                                         fa, fb = hydrostatic_pair(k_hyd * dz)
                                         g = 2.0 * delta * hc0 * rdotg * inv_r2e
                                         drab = ra - rb
-                                        acc[t, 2, a] += g * (drab - rho0 * fa) * Vb
-                                        acc[t, 2, b] += g * (-drab - rho0 * fb) * Va
+                                        s_drho += g * (drab - rho0 * fa) * Vb
+                                        drho_b += g * (-drab - rho0 * fb) * Va
+                                at[b, DRHO] += drho_b
                                 if shifting:
                                     # concentration counts particles: volume dp^2 each
                                     sx = dp2 * F * dx
                                     sz = dp2 * F * dz
-                                    acc[t, 3, a] += sx
-                                    acc[t, 4, a] += sz
-                                    acc[t, 3, b] -= sx
-                                    acc[t, 4, b] -= sz
-                                    acc[t, 5, a] -= dp2 * rdotg
-                                    acc[t, 5, b] -= dp2 * rdotg
+                                    s_gcx += sx
+                                    s_gcz += sz
+                                    at[b, GCX] -= sx
+                                    at[b, GCZ] -= sz
+                                    s_divr -= dp2 * rdotg
+                                    at[b, DIVR] -= dp2 * rdotg
                                     if kb == 1:
-                                        acc[t, 6, a] -= F * wnx[b]
-                                        acc[t, 7, a] -= F * wnz[b]
+                                        s_wnx -= F * wnx[b]
+                                        s_wnz -= F * wnz[b]
                                     elif ka == 1:
-                                        acc[t, 6, b] -= F * wnx[a]
-                                        acc[t, 7, b] -= F * wnz[a]
+                                        at[b, WNX] -= F * wnx[a]
+                                        at[b, WNZ] -= F * wnz[a]
+                                if shift_correction:
+                                    # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
+                                    e = F * ((sdx[b] - sxa) * dx + (sdz[b] - sza) * dz)
+                                    s_divdr += Vb * e
+                                    at[b, DIVDR] += Va * e
+                            at[a, AX] += s_ax
+                            at[a, AZ] += s_az
+                            at[a, DRHO] += s_drho
+                            if shifting:
+                                at[a, GCX] += s_gcx
+                                at[a, GCZ] += s_gcz
+                                at[a, DIVR] += s_divr
+                                at[a, WNX] += s_wnx
+                                at[a, WNZ] += s_wnz
+                            if shift_correction:
+                                at[a, DIVDR] += s_divdr
             vmax[t] = vm
 
     return pair_loop
 
 
 @nb.njit(parallel=True, cache=True)
-def reduce_accumulators(acc, kind, gx, gz, out, nq):
-    """out[q, i] = sum_t acc[t, q, i]; gravity added to fluid accelerations.
+def reduce_accumulators(acc, kind, split, start, ncx, ncz, periodic, gx, gz, out, n):
+    """out[q, i] = sum_t acc[t, i, q] over the threads that wrote particle i (thread t
+    writes the particles of its columns and of the next column); gravity added to fluid
+    accelerations.
 
     Returns max |a| over fluid particles (for dt1).
     """
     nt = acc.shape[0]
-    n = acc.shape[2]
+    nq = acc.shape[2]
     amax = np.zeros(n)
     for i in nb.prange(n):
         for q in range(nq):
-            s = 0.0
-            for t in range(nt):
-                s += acc[t, q, i]
-            out[q, i] = s
+            out[q, i] = 0.0
+    for t in range(nt):
+        lo = start[split[t] * ncz]
+        hi = start[min(split[t + 1] + 1, ncx) * ncz]
+        for i in nb.prange(lo, hi):
+            for q in range(nq):
+                out[q, i] += acc[t, i, q]
+        if periodic and split[t + 1] == ncx and split[t] > 0:
+            for i in nb.prange(start[ncz]):
+                for q in range(nq):
+                    out[q, i] += acc[t, i, q]
+    for i in nb.prange(n):
         if kind[i] == 0:
             out[0, i] += gx
             out[1, i] += gz

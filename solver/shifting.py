@@ -133,72 +133,50 @@ def free_surface(x, z, kind, gcx, gcz, divr, start, n_active, ncx, ncz, periodic
             flag[i] = 1
 
 
-@nb.njit(parallel=True, cache=True)
-def lind_shift(x, z, kind, gcx, gcz, surface, wnx, wnz, s0, start, n_active, ncx, ncz, periodic,
-               period, x0, z0, csx, csz, D, h, clip, dx_out, dz_out):
+@nb.njit(cache=True)
+def near_surface(x, z, kind, surface, start, n_active, ncx, ncz, periodic, period, x0, z0,
+                 csx, csz, h, near):
+    """near[i] = 1 for fluid particles within 2h of a free-surface particle (surface ones
+    included). Scattered from the surface particles, which are few: serial."""
     four_h2 = 4.0 * h * h
+    for i in range(n_active):
+        near[i] = 0
+    for j in range(n_active):
+        if not surface[j]:
+            continue
+        near[j] = 1
+        ix = int(math.floor((x[j] - x0) / csx))
+        iz = int(math.floor((z[j] - z0) / csz))
+        for ddx in range(-1, 2):
+            for ddz in range(-1, 2):
+                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                if c < 0:
+                    continue
+                for i in range(start[c], start[c + 1]):
+                    if kind[i] != 0:
+                        continue
+                    ex = x[i] + shift - x[j]
+                    ez = z[i] - z[j]
+                    if ex * ex + ez * ez < four_h2:
+                        near[i] = 1
+
+
+@nb.njit(parallel=True, cache=True)
+def lind_shift(kind, gcx, gcz, near, wnx, wnz, s0, n_active, D, clip, dx_out, dz_out):
+    """dr = -D gradC, each component clipped, zero near the free surface (``near``)."""
     for i in nb.prange(n_active):
         dx_out[i] = 0.0
         dz_out[i] = 0.0
-        if kind[i] != 0 or surface[i]:
+        if kind[i] != 0 or near[i]:
             continue
-        ix = int(math.floor((x[i] - x0) / csx))
-        iz = int(math.floor((z[i] - z0) / csz))
-        near_surface = False
-        for ddx in range(-1, 2):
-            for ddz in range(-1, 2):
-                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
-                if c < 0:
-                    continue
-                for j in range(start[c], start[c + 1]):
-                    if not surface[j]:
-                        continue
-                    ex = x[i] - (x[j] + shift)
-                    ez = z[i] - z[j]
-                    if ex * ex + ez * ez < four_h2:
-                        near_surface = True
-                        break
-                if near_surface:
-                    break
-            if near_surface:
-                break
-        if not near_surface:
-            dx_out[i], dz_out[i] = _off_wall(min(max(-D * gcx[i], -clip), clip),
-                                             min(max(-D * gcz[i], -clip), clip), wnx[i], wnz[i], s0)
+        dx_out[i], dz_out[i] = _off_wall(min(max(-D * gcx[i], -clip), clip),
+                                         min(max(-D * gcz[i], -clip), clip), wnx[i], wnz[i], s0)
 
 
 @nb.njit(parallel=True, cache=True)
-def shift_divergence(x, z, kind, mass, rho, sdx, sdz, start, n_active, ncx, ncz, periodic,
-                     period, x0, z0, csx, csz, h, out):
-    """out[a] = div(dr)_a = sum_b V_b (dr_b - dr_a) . gradW_ab over all neighbours (walls
-    have dr = 0), for fluid particles."""
-    alpha = 7.0 / (4.0 * math.pi * h * h)
-    fac = -5.0 * alpha / (h * h)
-    four_h2 = 4.0 * h * h
-    for i in nb.prange(n_active):
-        out[i] = 0.0
-        if kind[i] != 0:
-            continue
-        ix = int(math.floor((x[i] - x0) / csx))
-        iz = int(math.floor((z[i] - z0) / csz))
-        s = 0.0
-        for ddx in range(-1, 2):
-            for ddz in range(-1, 2):
-                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
-                if c < 0:
-                    continue
-                for j in range(start[c], start[c + 1]):
-                    if j == i:
-                        continue
-                    ex = x[i] - (x[j] + shift)
-                    ez = z[i] - z[j]
-                    r2 = ex * ex + ez * ez
-                    if r2 >= four_h2:
-                        continue
-                    s2 = 1.0 - 0.5 * math.sqrt(r2) / h
-                    F = fac * s2 * s2 * s2
-                    ddx_ = sdx[j] - sdx[i]
-                    ddz_ = sdz[j] - sdz[i]
-                    s += mass[j] / rho[j] * F * (ddx_ * ex + ddz_ * ez)
-        out[i] = s
-
+def limit_correction(rho, kind, div, n, limit):
+    """rho *= 1 - div(dr) for fluid particles, |div(dr)| limited to ``limit``."""
+    for i in nb.prange(n):
+        if kind[i] == 0:
+            d = min(max(div[i], -limit), limit)
+            rho[i] *= 1.0 - d

@@ -13,6 +13,7 @@ from .scene import Scene
 
 _SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "wnx", "wnz",
            "pid")
+_SHIFT = ("shift_dx", "shift_dz")  # the last shift, pending its density correction
 
 
 def default_domain(scene: Scene) -> tuple[float, float, float, float]:
@@ -65,8 +66,11 @@ class Simulation:
         self.delta = s.physics.density_diffusion or 0.0
         self.diffusion = self.delta > 0
         self.shift_method = s.physics.shifting.method
-        self.nq = forces.NQ if self.shift_method != "none" else 3
-        self.pair_loop = forces.make_pair_loop(self.diffusion, self.shift_method != "none")
+        shifting_on = self.shift_method != "none"
+        self.correct_shift = shifting_on and s.shift_density_correction
+        self.nq = forces.n_slots(shifting_on, self.correct_shift)
+        self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift)
+        self.sorted_fields = _SORTED + (_SHIFT if self.correct_shift else ())
         self.mdbc = s.physics.boundary == "mdbc"
 
         x0, x1, z0, z1 = default_domain(s)
@@ -76,7 +80,7 @@ class Simulation:
         self.moving = np.array([w.moving for w in s.walls] or [False])
 
         self.nthreads = nb.get_num_threads()
-        self.acc = np.zeros((self.nthreads, self.nq, self.n))
+        self.acc = np.zeros((self.nthreads, self.n, self.nq))
         self.out = np.zeros((self.nq, self.n))
         self.vmax_t = np.zeros(self.nthreads)
         self.split = np.zeros(self.nthreads + 1, dtype=np.int64)
@@ -86,8 +90,8 @@ class Simulation:
         self.p = np.zeros(self.n)
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
-        self.shift_div = np.zeros(self.n)
         self.surface_flag = np.zeros(self.n, dtype=np.int8)
+        self.near_flag = np.zeros(self.n, dtype=np.int8)
         self.wall_s0 = shifting.wall_proximity_at_half_dp(self.h, s.dp)
         self._buf = {np.dtype(a.dtype): np.empty(self.n, a.dtype)
                      for a in (self.x, self.kind, self.wall, self.pid)}
@@ -99,7 +103,7 @@ class Simulation:
         self.info = StepInfo()
         self.reason = ""
         self._evaluate(0.0)
-        self.drho_prev[:] = self.out[2]
+        self.drho_prev[:] = self.out[forces.DRHO]
         self._update_dt()
         self.dt_first = self.info.dt
 
@@ -113,7 +117,7 @@ class Simulation:
                     f"z in [{self.domain[2]:.4g}, {self.domain[3]:.4g}] m at "
                     f"({self.x[bad]:.4g}, {self.z[bad]:.4g})")
         cells.counting_sort(self.cell, g.ncells + 1, self.order, self.start)
-        for name in _SORTED:
+        for name in self.sorted_fields:
             arr = getattr(self, name)
             buf = self._buf.setdefault(np.dtype(arr.dtype), np.empty(self.n, arr.dtype))
             cells.gather(arr, self.order, buf)
@@ -140,13 +144,24 @@ class Simulation:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
         self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
-                       self.wnx, self.wnz, self.start, g.ncx, g.ncz, g.periodic, g.period, self.split, self.h,
-                       self.nu, self.h * self.c0, self.rho0, self.rho0 * s.gravity[1] / self.B,
-                       self.delta, s.dp * s.dp, self.acc, self.vmax_t)
-        self.amax = forces.reduce_accumulators(self.acc, self.kind, s.gravity[0], s.gravity[1],
-                                               self.out, self.nq)
+                       self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.start, g.ncx, g.ncz,
+                       g.periodic, g.period, self.split, self.h, self.nu, self.h * self.c0, self.rho0,
+                       self.rho0 * s.gravity[1] / self.B, self.delta, s.dp * s.dp, self.acc, self.vmax_t)
+        self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.start, g.ncx, g.ncz,
+                                               g.periodic, s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
+        if self.correct_shift:
+            self._correct_density()
         return ""
+
+    def _correct_density(self):
+        """rho *= 1 - div(dr) for the last shift dr, div(dr) summed in this evaluation's pair
+        loop (one step after the shift: positions have moved by dt v since, a second-order
+        difference), limited per step; the shift is then consumed."""
+        shifting.limit_correction(self.rho, self.kind, self.out[forces.DIVDR], self.n_active,
+                                  self.scene.shift_correction_limit)
+        self.shift_dx[:] = 0.0
+        self.shift_dz[:] = 0.0
 
     def _update_dt(self):
         dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0, self.nu)
@@ -155,30 +170,28 @@ class Simulation:
     def _shift(self, dt: float):
         sh, g = self.scene.physics.shifting, self.grid
         A = self.scene.shifting_coefficient
-        gcx, gcz, divr, wnx, wnz = self.out[3], self.out[4], self.out[5], self.out[6], self.out[7]
+        o = self.out
+        gcx, gcz, divr = o[forces.GCX], o[forces.GCZ], o[forces.DIVR]
+        wnx, wnz = o[forces.WNX], o[forces.WNZ]
+        clip = sh.max_shift * self.scene.dp
         if self.shift_method == "skillen":
-            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.wall_s0, self.n_active, A,
-                                   self.h, dt, sh.surface_threshold, sh.max_shift * self.scene.dp,
+            shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.wall_s0,
+                                   self.n_active, A, self.h, dt, sh.surface_threshold, clip,
                                    self.shift_dx, self.shift_dz)
-        else:
+        elif self.shift_method == "lind":
             shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.start,
                                   self.n_active, g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0,
                                   g.csx, g.csz, self.h, sh.surface_threshold, shifting.SCAN_UPPER,
                                   self.surface_flag)
-            shifting.lind_shift(self.x, self.z, self.kind, gcx, gcz, self.surface_flag, wnx, wnz,
-                                self.wall_s0, self.start, self.n_active, g.ncx, g.ncz, g.periodic,
-                                g.period, g.x0, g.z0, g.csx, g.csz, 0.5 * A * self.h * self.h,
-                                self.h, sh.max_shift * self.scene.dp, self.shift_dx, self.shift_dz)
-        if self.scene.shift_density_correction:  # rho follows the volume change of the shift
-            shifting.shift_divergence(self.x, self.z, self.kind, self.mass, self.rho, self.shift_dx,
-                                      self.shift_dz, self.start, self.n_active, g.ncx, g.ncz,
-                                      g.periodic, g.period, g.x0, g.z0, g.csx, g.csz, self.h,
-                                      self.shift_div)
-            div = self.shift_div[:self.n_active]
-            lim = self.scene.shift_correction_limit
-            if lim < math.inf:
-                np.clip(div, -lim, lim, out=div)
-            self.rho[:self.n_active] *= 1.0 - div
+            shifting.near_surface(self.x, self.z, self.kind, self.surface_flag, self.start,
+                                  self.n_active, g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0,
+                                  g.csx, g.csz, self.h, self.near_flag)
+            shifting.lind_shift(self.kind, gcx, gcz, self.near_flag, wnx, wnz, self.wall_s0,
+                                self.n_active, 0.5 * A * self.h * self.h, clip,
+                                self.shift_dx, self.shift_dz)
+        else:
+            return
+        # the density follows the volume change of the shift at the next evaluation
         self.x[:self.n_active] += self.shift_dx[:self.n_active]
         self.z[:self.n_active] += self.shift_dz[:self.n_active]
 
@@ -200,7 +213,7 @@ class Simulation:
         reason = self._evaluate(t + 0.5 * dt)
         if reason:
             return self._stop(reason)
-        integrate.kick(self.u, self.w, self.rho, self.kind, self.out[0], self.out[1], self.out[2],
+        integrate.kick(self.u, self.w, self.rho, self.kind, self.out[forces.AX], self.out[forces.AZ], self.out[forces.DRHO],
                        self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc)
         vw = boundary.wall_velocities(s.walls, t + dt)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
@@ -230,7 +243,7 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + ("t", "steps", "info", "dt_first", "n_active", "reason")
+    _STATE = _SORTED + _SHIFT + ("t", "steps", "info", "dt_first", "n_active", "reason")
 
     def state(self) -> dict:
         """Everything needed to resume exactly where this simulation stands."""
@@ -249,7 +262,7 @@ class Simulation:
         reason = self._evaluate(self.t)
         if reason:
             raise RuntimeError(reason)
-        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r", "wall_nx", "wall_nz")[:self.nq]
+        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r", "wall_nx", "wall_nz", "div_dr")[:self.nq]
         inv = self._inverse_order()
         return {k: self.out[q][inv].copy() for q, k in enumerate(names)}
 

@@ -71,3 +71,13 @@ def test_diffusion_nearly_vanishes_on_hydrostatic_column():
     curvature = 6.0 / 7.0 * (sc.fluid.density * g * H) / (sc.c0 ** 2 * sc.fluid.density / 7)
     assert diff < 1.5 * curvature * scale
     assert curvature < 0.1  # i.e. at least a tenfold cancellation here
+
+
+def test_hydrostatic_pair_series_matches_pow():
+    """rho^H_ab's (1 +- x)^(1/7) - 1: the series below SERIES_MAX within 1.1e-12 of pow,
+    pow beyond it."""
+    from solver.forces import SERIES_MAX, hydrostatic_pair
+    for x in np.linspace(-0.999 * SERIES_MAX, 0.999 * SERIES_MAX, 401).tolist() + [0.05, -0.3]:
+        fa, fb = hydrostatic_pair(x)
+        assert abs(fa - ((1 + x) ** (1 / 7) - 1)) < 1.1e-12
+        assert abs(fb - ((1 - x) ** (1 / 7) - 1)) < 1.1e-12
