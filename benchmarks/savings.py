@@ -82,10 +82,10 @@ def compiled_out(threads: int, steps: int = 150) -> list[dict]:
         if force_diffusion or force_shift_sums:
             sim.diffusion = sim.diffusion or force_diffusion
             if force_shift_sums:
-                sim.nq = forces.NQ
-                sim.acc = np.zeros((sim.nthreads, sim.nq, sim.n))
+                sim.nq = forces.NQ_SHIFT
+                sim.acc = np.zeros((sim.nthreads, sim.n, sim.nq))
                 sim.out = np.zeros((sim.nq, sim.n))
-            sim.pair_loop = forces.make_pair_loop(sim.diffusion, force_shift_sums or shifting != "none")
+            sim.pair_loop = forces.make_pair_loop(sim.diffusion, force_shift_sums or shifting != "none", False)
         for _ in range(5):
             sim.step()
         tic = time.perf_counter()

@@ -2,11 +2,14 @@
 
 Layer: rho 1383, mu 5.6, slope 15.3 deg, periodic in x, ~40k particles (fluid + bed),
 mDBC and density diffusion on. One JSON object per configuration on stdout:
-  {"ch", "threads", "particles", "shifting", "steps", "wall_s", "particle_steps_per_s", ...}
-particle_steps_per_s = (all particles, fluid and boundary) x steps / wall seconds.
+  {"ch", "threads", "particles", "shifting", "steps", "wall_s", "particle_steps_per_s",
+   "ns_per_particle_step", "bytes_per_particle", ...}
+particle_steps_per_s = (all particles, fluid and boundary) x steps / wall seconds;
+bytes_per_particle = the solver's numpy arrays (state, sort buffers, per-thread
+accumulators, work arrays) over the particle count.
 
 Usage: python benchmarks/throughput.py [--steps 200] [--ch 1.5 1.8] [--threads 1 2]
-                                       [--shifting none lind skillen] [--particles 40000]
+                                       [--shifting none lind skillen] [--particles 40000 ...]
 """
 from __future__ import annotations
 
@@ -16,6 +19,7 @@ import math
 import time
 
 import numba
+import numpy as np
 
 from solver.scene import scene_from_dict
 from solver.simulation import Simulation
@@ -44,6 +48,18 @@ def layer_scene(ch: float, shifting: str, particles: int, dp: float = 1.0e-3) ->
     }
 
 
+def array_bytes(sim: Simulation) -> int:
+    """Bytes held in the simulation's numpy arrays (sort buffers included)."""
+    seen, total = set(), 0
+    arrays = [v for v in vars(sim).values() if isinstance(v, np.ndarray)]
+    arrays += list(sim._buf.values())
+    for a in arrays:
+        if id(a) not in seen:
+            seen.add(id(a))
+            total += a.nbytes
+    return total
+
+
 def measure(ch: float, threads: int, shifting: str, steps: int, particles: int) -> dict:
     numba.set_num_threads(threads)
     sim = Simulation(scene_from_dict(layer_scene(ch, shifting, particles)))
@@ -58,7 +74,9 @@ def measure(ch: float, threads: int, shifting: str, steps: int, particles: int) 
     return {"ch": ch, "threads": threads, "particles": sim.n, "fluid": sim.n_fluid,
             "shifting": shifting, "steps": steps, "wall_s": round(wall, 4),
             "particle_steps_per_s": round(sim.n * steps / wall),
-            "steps_per_s": round(steps / wall, 1)}
+            "ns_per_particle_step": round(1e9 * wall / (sim.n * steps), 1),
+            "steps_per_s": round(steps / wall, 1),
+            "bytes_per_particle": round(array_bytes(sim) / sim.n)}
 
 
 def main(argv=None):
@@ -67,12 +85,13 @@ def main(argv=None):
     ap.add_argument("--ch", type=float, nargs="+", default=[1.5, 1.8])
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--shifting", nargs="+", default=["none", "lind", "skillen"])
-    ap.add_argument("--particles", type=int, default=40000)
+    ap.add_argument("--particles", type=int, nargs="+", default=[40000])
     a = ap.parse_args(argv)
-    for ch in a.ch:
-        for shifting in a.shifting:
-            for threads in a.threads:
-                print(json.dumps(measure(ch, threads, shifting, a.steps, a.particles)), flush=True)
+    for particles in a.particles:
+        for ch in a.ch:
+            for shifting in a.shifting:
+                for threads in a.threads:
+                    print(json.dumps(measure(ch, threads, shifting, a.steps, particles)), flush=True)
 
 
 if __name__ == "__main__":

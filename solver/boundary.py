@@ -13,6 +13,7 @@ no-slip velocity v_b = 2 v_wall - v_g with v_g the Shepard-interpolated fluid ve
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numba as nb
@@ -20,6 +21,7 @@ import numpy as np
 
 from .cells import neighbour_cell
 
+from .forces import FASTMATH
 from .kernel import grad_factor, w_value
 
 DET_MIN = 1.0e-3  # on the matrix made dimensionless with h
@@ -29,7 +31,9 @@ def wall_velocities(walls, t: float) -> np.ndarray:
     """(n_walls, 2) imposed velocity of each wall at time t, with its linear ramp."""
     out = np.zeros((max(len(walls), 1), 2))
     for i, w in enumerate(walls):
-        if w.ramp_time > 0:
+        if t == math.inf:
+            f = 1.0
+        elif w.ramp_time > 0:
             f = min(max((t - w.ramp_delay) / w.ramp_time, 0.0), 1.0)
         else:
             f = 1.0 if t >= w.ramp_delay else 0.0
@@ -57,99 +61,106 @@ def _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, b0, b1, b2):
     return y0, y1, y2
 
 
-@nb.njit(parallel=True, cache=True)
-def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_active,
-                x0, z0, csx, csz, ncx, ncz, periodic, period, h, rho0, corrected_velocity):
-    """Set density and no-slip velocity of every active boundary particle from its ghost.
+@functools.cache
+def make_mdbc_update(corrected_velocity: bool):
+    """Compile the mDBC update with the Shepard or the corrected ghost velocity."""
 
-    v_g is Shepard-interpolated (SPEC), or first-order corrected like the density when
-    ``corrected_velocity`` (and the matrix is well conditioned).
-    """
-    alpha = 7.0 / (4.0 * math.pi * h * h)
-    fac = -5.0 * alpha / (h * h)
-    four_h2 = 4.0 * h * h
-    for i in nb.prange(n_active):
-        if kind[i] != 1:
-            continue
-        gx, gz = gxs[i], gzs[i]
-        vwx, vwz = vwall[wall[i], 0], vwall[wall[i], 1]
-        if not math.isfinite(gx):
-            rho[i] = rho0
-            u[i] = vwx
-            w[i] = vwz
-            continue
-        if periodic:
-            gx = x0 + (gx - x0) % period
-        ix = int(math.floor((gx - x0) / csx))
-        iz = int(math.floor((gz - z0) / csz))
-        a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
-        b0 = b1 = b2 = 0.0
-        su = sw = 0.0
-        bu1 = bu2 = bw1 = bw2 = 0.0
-        for ddx in range(-1, 2):
-            for ddz in range(-1, 2):
-                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
-                if c < 0:
-                    continue
-                for j in range(start[c], start[c + 1]):
-                    if kind[j] != 0:
+    @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
+    def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_active,
+                    x0, z0, csx, csz, ncx, ncz, periodic, period, h, rho0):
+        """Set density and no-slip velocity of every active boundary particle from its ghost.
+
+        v_g is Shepard-interpolated (SPEC), or first-order corrected like the density when
+        ``corrected_velocity`` (and the matrix is well conditioned).
+        """
+        alpha = 7.0 / (4.0 * math.pi * h * h)
+        fac = -5.0 * alpha / (h * h)
+        four_h2 = 4.0 * h * h
+        for i in nb.prange(n_active):
+            if kind[i] != 1:
+                continue
+            gx, gz = gxs[i], gzs[i]
+            vwx, vwz = vwall[wall[i], 0], vwall[wall[i], 1]
+            if not math.isfinite(gx):
+                rho[i] = rho0
+                u[i] = vwx
+                w[i] = vwz
+                continue
+            if periodic:
+                gx = x0 + (gx - x0) % period
+            ix = int(math.floor((gx - x0) / csx))
+            iz = int(math.floor((gz - z0) / csz))
+            a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
+            b0 = b1 = b2 = 0.0
+            su = sw = 0.0
+            bu1 = bu2 = bw1 = bw2 = 0.0
+            for ddx in range(-1, 2):
+                for ddz in range(-1, 2):
+                    c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                    if c < 0:
                         continue
-                    dx = gx - (x[j] + shift)  # r_gj
-                    dz = gz - z[j]
-                    r2 = dx * dx + dz * dz
-                    if r2 >= four_h2:
-                        continue
-                    q = math.sqrt(r2) / h
-                    Wv = w_value(q, alpha)
-                    F = grad_factor(q, fac)
-                    V = mass[j] / rho[j]
-                    WV = Wv * V
-                    gxv = F * dx * V
-                    gzv = F * dz * V
-                    # r_j - r_g = -(dx, dz); unknown gradient scaled by h
-                    a00 += WV
-                    a01 -= dx * WV / h
-                    a02 -= dz * WV / h
-                    a10 += gxv * h
-                    a11 -= gxv * dx
-                    a12 -= gxv * dz
-                    a20 += gzv * h
-                    a21 -= gzv * dx
-                    a22 -= gzv * dz
-                    b0 += rho[j] * WV
-                    b1 += rho[j] * gxv * h
-                    b2 += rho[j] * gzv * h
-                    su += u[j] * WV
-                    sw += w[j] * WV
-                    bu1 += u[j] * gxv * h
-                    bu2 += u[j] * gzv * h
-                    bw1 += w[j] * gxv * h
-                    bw2 += w[j] * gzv * h
-        if a00 <= 0.0:
-            rho[i] = rho0
-            u[i] = vwx
-            w[i] = vwz
-            continue
-        det = (a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20)
-               + a02 * (a10 * a21 - a11 * a20))
-        well_posed = abs(det) >= DET_MIN
-        if well_posed:
-            rg, gdx, gdz = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, b0, b1, b2)
-            ddxg = x[i] - gx
-            if periodic:  # nearest image
-                ddxg -= period * math.floor(ddxg / period + 0.5)
-            # extrapolate only outward-increasing density: a pressure that falls into the
-            # wall (fluid pushed towards it) would leave the wall weaker than the fluid at
-            # its ghost node, and the fluid would walk through it
-            rb = max(rg + (ddxg * gdx + (z[i] - gz) * gdz) / h, rg)
-        else:
-            rb = b0 / a00
-        if corrected_velocity and well_posed:
-            ug = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0]
-            wg = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0]
-        else:
-            ug = su / a00
-            wg = sw / a00
-        rho[i] = max(rb, rho0)  # walls push, never pull: no tension at a wall
-        u[i] = 2.0 * vwx - ug
-        w[i] = 2.0 * vwz - wg
+                    for j in range(start[c], start[c + 1]):
+                        if kind[j] != 0:
+                            continue
+                        dx = gx - (x[j] + shift)  # r_gj
+                        dz = gz - z[j]
+                        r2 = dx * dx + dz * dz
+                        if r2 >= four_h2:
+                            continue
+                        q = math.sqrt(r2) / h
+                        Wv = w_value(q, alpha)
+                        F = grad_factor(q, fac)
+                        V = mass[j] / rho[j]
+                        WV = Wv * V
+                        gxv = F * dx * V
+                        gzv = F * dz * V
+                        # r_j - r_g = -(dx, dz); unknown gradient scaled by h
+                        a00 += WV
+                        a01 -= dx * WV / h
+                        a02 -= dz * WV / h
+                        a10 += gxv * h
+                        a11 -= gxv * dx
+                        a12 -= gxv * dz
+                        a20 += gzv * h
+                        a21 -= gzv * dx
+                        a22 -= gzv * dz
+                        b0 += rho[j] * WV
+                        b1 += rho[j] * gxv * h
+                        b2 += rho[j] * gzv * h
+                        su += u[j] * WV
+                        sw += w[j] * WV
+                        if corrected_velocity:
+                            bu1 += u[j] * gxv * h
+                            bu2 += u[j] * gzv * h
+                            bw1 += w[j] * gxv * h
+                            bw2 += w[j] * gzv * h
+            if a00 <= 0.0:
+                rho[i] = rho0
+                u[i] = vwx
+                w[i] = vwz
+                continue
+            det = (a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20)
+                   + a02 * (a10 * a21 - a11 * a20))
+            well_posed = abs(det) >= DET_MIN
+            if well_posed:
+                rg, gdx, gdz = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, b0, b1, b2)
+                ddxg = x[i] - gx
+                if periodic:  # nearest image
+                    ddxg -= period * math.floor(ddxg / period + 0.5)
+                # extrapolate only outward-increasing density: a pressure that falls into the
+                # wall (fluid pushed towards it) would leave the wall weaker than the fluid at
+                # its ghost node, and the fluid would walk through it
+                rb = max(rg + (ddxg * gdx + (z[i] - gz) * gdz) / h, rg)
+            else:
+                rb = b0 / a00
+            if corrected_velocity and well_posed:
+                ug = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0]
+                wg = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0]
+            else:
+                ug = su / a00
+                wg = sw / a00
+            rho[i] = max(rb, rho0)  # walls push, never pull: no tension at a wall
+            u[i] = 2.0 * vwx - ug
+            w[i] = 2.0 * vwz - wg
+
+    return mdbc_update

@@ -18,6 +18,7 @@ from .scene import Scene, SceneError, YamlData, parse_into, read_yaml, scene_fro
 from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication", "warm")
+START_VELOCITIES = ("rest", "lubrication")
 
 
 @dataclass
@@ -70,6 +71,7 @@ class ConveyorCase(YamlData):
     belt: Belt = field(default_factory=Belt)
     fluid_length: float = 20.0  # in h_n, of the initial block (the lubrication start keeps its area)
     start: str = "lubrication"
+    start_velocity: str = "rest"  # or lubrication: the steady film profile, belt running from t = 0
     warm_from: str | None = None  # start: warm: a front run's NetCDF (another dp) to start from
     wall_height: float = 2.5  # upstream wall, in h_n
     normalising_depth: float = 0.0186  # m: the paper's h_n used to normalise its data
@@ -95,9 +97,15 @@ class ConveyorCase(YamlData):
                                         self.gravity, self.theta)
 
     @property
+    def running_start(self) -> bool:
+        """The fluid starts moving (warm start, or the lubrication velocity profile) and the
+        belt runs at full speed from t = 0, without rest or ramp."""
+        return self.start == "warm" or self.start_velocity == "lubrication"
+
+    @property
     def ramp_end(self) -> float:
-        """End of the belt start-up (0 for a warm start: the belt is already running)."""
-        return 0.0 if self.start == "warm" else self.belt.rest + self.belt.ramp
+        """End of the belt start-up (0 for a running start)."""
+        return 0.0 if self.running_start else self.belt.rest + self.belt.ramp
 
     def criteria(self) -> SteadyCriteria:
         s = self.steady
@@ -128,6 +136,12 @@ def validate_case(c: ConveyorCase) -> None:
         raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
     if c.start not in START_SHAPES:
         raise SceneError(f"case.start: {c.start!r} is not one of {', '.join(START_SHAPES)}")
+    if c.start_velocity not in START_VELOCITIES:
+        raise SceneError(f"case.start_velocity: {c.start_velocity!r} is not one of "
+                         f"{', '.join(START_VELOCITIES)}")
+    if c.start == "warm" and c.start_velocity != "rest":
+        raise SceneError("case.start_velocity: a warm start takes its velocities from warm_from; "
+                         "leave start_velocity at rest")
     if c.start == "warm" and not c.warm_from:
         raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")
@@ -200,7 +214,7 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
     hn, th, g = c.h_n, c.theta, c.gravity
     T = wall_thickness(c)
     x_toe = initial_toe(c, warm)
-    rest, ramp = (0.0, 0.0) if c.start == "warm" else (c.belt.rest, c.belt.ramp)
+    rest, ramp = (0.0, 0.0) if c.running_start else (c.belt.rest, c.belt.ramp)
     belt_end = c.dp * math.ceil((x_toe + c.belt.margin * hn) / c.dp)
     wall_top = c.dp * math.ceil(c.wall_height * hn / c.dp)
     # a belt running at full speed into the fixed wall is a corner singularity that squeezes
@@ -249,3 +263,28 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
 
 def build_scene(c: ConveyorCase, warm=None) -> Scene:
     return scene_from_dict(build_scene_dict(c, warm))
+
+
+def belt_speed_at(c: ConveyorCase, x: np.ndarray) -> np.ndarray:
+    """|belt velocity| under x: u_b, and the taper's (k + 1/2)/n u_b near the upstream wall."""
+    n = c.belt.taper_segments if c.belt.taper_length > 0 else 0
+    speed = np.full(np.shape(x), c.belt.speed)
+    for k in range(n):
+        lo = c.dp * round(k * c.belt.taper_length * c.h_n / n / c.dp)
+        hi = c.dp * round((k + 1) * c.belt.taper_length * c.h_n / n / c.dp)
+        speed[(x >= lo) & (x < hi)] = (k + 0.5) / n * c.belt.speed
+    return speed
+
+
+def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.ndarray):
+    """Lab-frame (u, w) of the steady film at fluid points: u = U (u*(z/h) - 1), w = 0, with
+    u* = 3 (s - s^2/2) of SPEC section 5 at the local depth h of the initial surface and U
+    the belt speed under the point. The depth-mean lab velocity is then zero: no net flux."""
+    if scene.fluid.profiles:
+        prof = scene.fluid.profiles[0]
+        depth = prof.top(x) - prof.base
+    else:
+        depth = np.full(np.shape(x), c.h_n)
+    s = np.clip(z / np.maximum(depth, 1e-12), 0.0, 1.0)
+    u = belt_speed_at(c, x) * (lubrication.belt_velocity(s) - 1.0)
+    return u, np.zeros_like(u)

@@ -19,6 +19,7 @@ from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, toe_position
 from .run import Runner
 from .simulation import Simulation
+from .sources import source_hash
 
 SERIES = ("toe", "uniform_depth", "enclosed_area", "mass_area", "number_density")
 
@@ -162,8 +163,11 @@ class FrontMonitor:
         return ds
 
 
-def case_hash(case: ConveyorCase) -> str:
-    return hashlib.sha256(case.to_yaml().encode()).hexdigest()[:16]
+def checkpoint_key(case: ConveyorCase, threads: int) -> str:
+    """A checkpoint resumes only the same case, on the same solver sources and thread count
+    (another thread count sums in another order: the result would not be bit-for-bit)."""
+    text = f"{case.to_yaml()}\nsolver {source_hash()}\nthreads {threads}"
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 class Checkpointer:
@@ -202,6 +206,8 @@ class Checkpointer:
         except Exception:
             return False
         if state.get("key") != self.key:
+            print(f"note: ignoring the checkpoint {self.path}: written for another case, solver "
+                  "version or thread count; starting from t = 0", file=sys.stderr)
             return False
         runner.sim.restore(state["sim"])
         runner.res = state["res"]
@@ -240,13 +246,21 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         if warm_note:
             case = replace(case, start="lubrication", warm_from=None)
         scene = build_scene(case)
-        sim = Simulation(scene)
+        if case.start_velocity == "lubrication":
+            from .build import build_particles
+            from .conveyor import lubrication_velocity
+            parts = build_particles(scene)
+            f = parts.kind == 0
+            parts.u[f], parts.w[f] = lubrication_velocity(case, scene, parts.x[f], parts.z[f])
+            sim = Simulation(scene, parts)
+        else:
+            sim = Simulation(scene)
     monitor = FrontMonitor(case)
     runner = Runner(scene, sim, monitors=[monitor], final_snapshot=True)
     ckpt = None
     resumed = False
     if checkpoint is not None:
-        ckpt = Checkpointer(checkpoint, case.checkpoint_interval, case_hash(case))
+        ckpt = Checkpointer(checkpoint, case.checkpoint_interval, checkpoint_key(case, runner.res.threads))
         resumed = ckpt.restore(runner)
         monitor = runner.monitors[0]
     res = runner.run(quiet=quiet, on_step=ckpt)

@@ -72,12 +72,16 @@ class Simulation:
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift)
         self.sorted_fields = _SORTED + (_SHIFT if self.correct_shift else ())
         self.mdbc = s.physics.boundary == "mdbc"
+        self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected")
 
         x0, x1, z0, z1 = default_domain(s)
         self.domain = (x0, x1, z0, z1)
         self.grid = cells.Grid.cover(x0, x1, z0, z1, 2.0 * self.h, s.periodic_x is not None)
         self.walls = np.array([[w.x[0], w.x[1], w.z[0], w.z[1]] for w in s.walls]).reshape(-1, 4)
         self.moving = np.array([w.moving for w in s.walls] or [False])
+        # wall velocities are constant once every ramp has ended
+        self.ramps_end = max([w.ramp_delay + w.ramp_time for w in s.walls] or [0.0])
+        self.vwall_final = boundary.wall_velocities(s.walls, math.inf)
 
         self.nthreads = nb.get_num_threads()
         self.acc = np.zeros((self.nthreads, self.n, self.nq))
@@ -128,18 +132,21 @@ class Simulation:
         cells.column_split(self.start, g.ncx, g.ncz, self.nthreads, self.split)
         return ""
 
+    def wall_velocities(self, t: float) -> np.ndarray:
+        return self.vwall_final if t >= self.ramps_end else boundary.wall_velocities(self.scene.walls, t)
+
     def _evaluate(self, t: float) -> str:
         """Sort, set wall particles, and compute accelerations and drho/dt at time t."""
         reason = self._sort()
         if reason:
             return reason
         g, s = self.grid, self.scene
-        vwall = boundary.wall_velocities(s.walls, t)
+        vwall = self.wall_velocities(t)
         if self.mdbc:
-            boundary.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
+            self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
                                  self.wall, self.gx, self.gz, vwall, self.start, self.n_active,
                                  g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
-                                 self.h, self.rho0, s.physics.mdbc_velocity == "corrected")
+                                 self.h, self.rho0)
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
@@ -205,7 +212,7 @@ class Simulation:
         dt = self.info.dt if dt is None else dt
         s = self.scene
         t = self.t
-        vw = boundary.wall_velocities(s.walls, t)
+        vw = self.wall_velocities(t)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
                         vw, self.moving, 0.5 * dt, self.n)
         integrate.advance_density(self.rho, self.drho_prev, self.n_active, 0.5 * dt)
@@ -215,7 +222,7 @@ class Simulation:
             return self._stop(reason)
         integrate.kick(self.u, self.w, self.rho, self.kind, self.out[forces.AX], self.out[forces.AZ], self.out[forces.DRHO],
                        self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc)
-        vw = boundary.wall_velocities(s.walls, t + dt)
+        vw = self.wall_velocities(t + dt)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
                         vw, self.moving, 0.5 * dt, self.n)
         if self.shift_method != "none":

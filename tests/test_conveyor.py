@@ -157,3 +157,18 @@ def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
     assert ds.attrs["status"] == "not_steady"
     assert ds.attrs["warm_start"].startswith("fallback to the lubrication start") and "diverged" in ds.attrs["warm_start"]
     assert "start: lubrication" in ds.attrs["case_yaml"]
+
+
+def test_checkpoint_key_covers_case_solver_and_threads(monkeypatch):
+    """A checkpoint written by another solver version or thread count is never resumed."""
+    from solver import front
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        d = yaml.safe_load(fh)
+    from solver.conveyor import case_from_dict
+    case = case_from_dict(d)
+    key = front.checkpoint_key(case, 2)
+    assert key == front.checkpoint_key(case_from_dict(d), 2)
+    assert key != front.checkpoint_key(case, 1)
+    assert key != front.checkpoint_key(case_from_dict({**d, "cfl": 0.25}), 2)
+    monkeypatch.setattr(front, "source_hash", lambda: "another solver")
+    assert key != front.checkpoint_key(case, 2)

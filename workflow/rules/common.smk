@@ -28,18 +28,9 @@ def _write_if_changed(path, text):
 CONFIG_FILE = "results/campaign_config.yaml"
 _write_if_changed(CONFIG_FILE, yaml.safe_dump(config, sort_keys=False))
 
-def _solver_hash():
-    """Hash of the solver's sources: a param of every run, so a changed solver reruns them."""
-    import hashlib
-    import pathlib
-    import solver
-    h = hashlib.sha256()
-    for f in sorted(pathlib.Path(solver.__file__).parent.glob("*.py")):
-        h.update(f.name.encode() + f.read_bytes())
-    return h.hexdigest()[:16]
+from solver.sources import source_hash
 
-
-SOLVER_HASH = _solver_hash()
+SOLVER_HASH = source_hash()  # a param of every run: a changed solver reruns them
 
 wildcard_constraints:
     case=CASE_ID,

@@ -1,0 +1,96 @@
+"""Time to a steady answer: the paper case at dp = 1 mm, Ch = 1.8, to steady state plus its
+averaging window, with the shipped settings and with variants, and the run-to-run spread.
+
+Each variant runs `python -m solver front examples/conveyor.yaml` with `--set` overrides on
+--threads threads (default 2) and reports wall time, steps, particle-steps/s, the steady
+time, the simulated time and every metric of SPEC section 4 against lubrication theory.
+
+The run-to-run spread (--spread) is the metric difference between the same case run on 1
+and on 2 threads: the two sum the pair contributions in another order, so round-off starts
+two trajectories of the same physics apart, and whatever a metric changes by between them
+is noise. A variant's metrics count as "equal" to the shipped case's when every difference
+is within that spread (or within 10 % of the shipped value, whichever is larger: one pair of
+runs measures the spread only roughly).
+
+Usage: python benchmarks/time_to_solution.py [--shifting skillen lind] [--threads 2]
+           [--variants shipped ...] [--spread] [--out results/time_to_solution]
+Runs already in --out are reused (delete them to rerun). Prints a Markdown table.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import xarray as xr
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from savings import METRICS, metrics_of, run_case  # noqa: E402
+
+# --set overrides of each variant on top of examples/conveyor.yaml (which is the shipped case)
+VARIANTS = {
+    "shipped": [],
+    "average_1s": ["steady.average=1.0"],
+    "cfl_0.3": ["cfl=0.3"],
+    "cfl_0.3_average_1s": ["cfl=0.3", "steady.average=1.0"],
+}
+
+
+def describe(path: Path) -> dict:
+    m = metrics_of(path)
+    with xr.open_dataset(path) as run:
+        steps = int(run.attrs["steps"])
+        n = int(run.attrs["n_fluid"]) + int(run.attrs["n_boundary"])
+    m.update(steps=steps, particles=n, rate=n * steps / m["wall"])
+    return m
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--shifting", nargs="+", default=["skillen", "lind"])
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--variants", nargs="+", default=["shipped"], choices=sorted(VARIANTS))
+    ap.add_argument("--spread", action="store_true", help="also run the shipped case on 1 thread")
+    ap.add_argument("--out", default=str(ROOT / "results" / "time_to_solution"))
+    a = ap.parse_args(argv)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for method in a.shifting:
+        results = {}
+        for v in a.variants:
+            sets = [f"shifting={method}"] + VARIANTS[v]
+            results[v] = describe(run_case(out, f"{method}_{v}_t{a.threads}", sets, a.threads))
+        spread = None
+        if a.spread:
+            one = describe(run_case(out, f"{method}_shipped_t1", [f"shifting={method}"], 1))
+            base = results.get("shipped") or describe(
+                run_case(out, f"{method}_shipped_t{a.threads}", [f"shifting={method}"], a.threads))
+            spread = {k: abs(one[k] - base[k]) for k in METRICS}
+            results["shipped, 1 thread"] = one
+        for v, m in results.items():
+            rows.append((method, v, m, spread, results.get("shipped")))
+    (out / "time_to_solution.json").write_text(json.dumps(
+        [{"shifting": r[0], "variant": r[1], **r[2]} for r in rows], indent=1))
+    head = ("| shifting | variant | status | steady at [s] | simulated [s] | steps | wall [s] | "
+            "M particle-steps/s | " + " | ".join(METRICS) + " | equal to shipped |")
+    print(head)
+    print("|" + "---|" * (head.count("|") - 1))
+    for method, v, m, spread, base in rows:
+        verdict = "-"
+        if base is not None and v not in ("shipped", "shipped, 1 thread"):
+            tol = {k: max(spread[k] if spread else 0.0, 0.1 * abs(base[k])) for k in METRICS}
+            verdict = "yes" if all(abs(m[k] - base[k]) <= tol[k] for k in METRICS) else "no"
+        print(f"| {method} | {v} | {m['status']} | {m['steady_at']:.2f} | {m['simulated']:.2f} | "
+              f"{m['steps']} | {m['wall']:.0f} | {m['rate'] / 1e6:.2f} | "
+              + " | ".join(f"{m[k]:.4f}" for k in METRICS) + f" | {verdict} |")
+    for method, v, m, spread, base in rows:
+        if spread and v == "shipped":
+            print(f"\nrun-to-run spread ({method}, 1 against {a.threads} threads): "
+                  + ", ".join(f"{k} {spread[k]:.4f}" for k in METRICS))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,89 @@
+"""How far the viscous time-step limit dt3 = h^2 / nu can be stretched, measured.
+
+At the paper's finest resolution (dp = 0.25 mm, Ch = 1.8) the viscous limit C_CFL h^2/nu is
+half the acoustic one, so it doubles the step count there. This script runs the film of
+SPEC section 7 (the paper fluid on the 15.3 deg incline, depth h_n = 18.76 mm, periodic,
+coefsound 10 as in the conveyor case) at that dp and Ch from rest, with a fixed step
+dt = C h^2 / nu for each C, to --end seconds (several viscous times H^2/nu = 0.087 s), and
+reports whether it stays bounded and the RMS error of u(z) against the exact
+semi-parabolic profile (in units of its surface velocity) at the end, beside the acoustic
+step 0.2 h / c0 the solver would otherwise take.
+
+Usage: python benchmarks/viscous_limit.py [--dp 0.00025] [--ch 1.8] [--c 0.2 0.25 0.3 0.35 0.42]
+           [--end 0.3] [--threads 2]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+import yaml
+
+from solver.scene import scene_from_dict
+from solver.simulation import Simulation
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def film(dp: float, ch: float, end: float) -> dict:
+    d = yaml.safe_load((ROOT / "examples" / "film.yaml").read_text())
+    H = 0.01876
+    L = 24 * dp
+    T = math.ceil(2 * ch) * dp
+    d.update(dp=dp, ch=ch, periodic_x=[0.0, L], cfl=0.2)
+    d["fluid"]["blocks"] = [{"x": [0.0, L], "z": [0.0, H]}]
+    d["walls"] = [{"name": "bed", "x": [0.0, L], "z": [-T, 0.0]}]
+    d["time"] = {"end": end, "output_interval": end}
+    return d
+
+
+def exact_error(sim: Simulation) -> float:
+    """RMS of u - u_exact over fluid particles, over the exact surface velocity."""
+    s = sim.scene
+    n = sim.n_active
+    f = sim.kind[:n] == 0
+    z, u = sim.z[:n][f], sim.u[:n][f]
+    H = max(b.z[1] for b in s.fluid.blocks)
+    g = s.gravity[0]
+    exact = g / s.nu * (H * z - 0.5 * z * z)
+    return float(np.sqrt(np.mean((u - exact) ** 2)) / (g / s.nu * 0.5 * H * H))
+
+
+def run(dp: float, ch: float, C: float, end: float) -> dict:
+    sim = Simulation(scene_from_dict(film(dp, ch, end)))
+    dt = C * sim.h ** 2 / sim.nu
+    acoustic = 0.2 * sim.h / sim.c0
+    steps = int(math.ceil(end / dt))
+    tic = time.perf_counter()
+    reason = ""
+    for _ in range(steps):
+        reason = sim.step(dt)
+        if reason:
+            break
+    wall = time.perf_counter() - tic
+    return {"dp": dp, "ch": ch, "C": C, "dt": dt, "acoustic_dt": acoustic, "steps": sim.steps,
+            "t": sim.t, "status": "diverged" if reason else "bounded", "reason": reason,
+            "u_rms_error": math.nan if reason else exact_error(sim), "wall_s": round(wall, 1),
+            "particles": sim.n}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--dp", type=float, default=0.00025)
+    ap.add_argument("--ch", type=float, default=1.8)
+    ap.add_argument("--c", type=float, nargs="+", default=[0.2, 0.25, 0.3, 0.35, 0.42])
+    ap.add_argument("--end", type=float, default=0.3)
+    ap.add_argument("--threads", type=int, default=2)
+    a = ap.parse_args(argv)
+    numba.set_num_threads(a.threads)
+    for C in a.c:
+        print(json.dumps(run(a.dp, a.ch, C, a.end)), flush=True)
+
+
+if __name__ == "__main__":
+    main()
