@@ -7,7 +7,8 @@ lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp;
          where thr <= div r < 1.9, see free_surface).
 Density correction (default on): shifting moves particles relative to the fluid, so each
 particle's volume changes by V div(dr); with its mass fixed its density becomes
-rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab. Without it, shifting that
+rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab, summed in the next
+step's pair loop and applied after it (``limit_correction``). Without it, shifting that
 spreads particles near a free surface inflates the fluid at constant density (measured on
 the periodic film: +2.1 % area in 1 s with skillen; on the paper case at dp = 1 mm with
 lind, +2 % of enclosed area by t = 2.1 s). Lind relocates particles by up to 0.1 dp every

@@ -144,9 +144,9 @@ class Simulation:
         vwall = self.wall_velocities(t)
         if self.mdbc:
             self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
-                                 self.wall, self.gx, self.gz, vwall, self.start, self.n_active,
-                                 g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
-                                 self.h, self.rho0)
+                             self.wall, self.gx, self.gz, vwall, self.start, self.n_active,
+                             g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
+                             self.h, self.rho0)
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
@@ -162,9 +162,9 @@ class Simulation:
         return ""
 
     def _correct_density(self):
-        """rho *= 1 - div(dr) for the last shift dr, div(dr) summed in this evaluation's pair
-        loop (one step after the shift: positions have moved by dt v since, a second-order
-        difference), limited per step; the shift is then consumed."""
+        """rho *= 1 - div(dr) for the last shift dr, with div(dr) summed in this evaluation's
+        pair loop, one step after the shift (positions have moved by dt v since, about
+        0.01 dp per step on the paper case), limited per step; the shift is then consumed."""
         shifting.limit_correction(self.rho, self.kind, self.out[forces.DIVDR], self.n_active,
                                   self.scene.shift_correction_limit)
         self.shift_dx[:] = 0.0
@@ -175,6 +175,8 @@ class Simulation:
         self.info = StepInfo(dt, k, lim)
 
     def _shift(self, dt: float):
+        if self.shift_method == "none":
+            return
         sh, g = self.scene.physics.shifting, self.grid
         A = self.scene.shifting_coefficient
         o = self.out
@@ -196,8 +198,6 @@ class Simulation:
             shifting.lind_shift(self.kind, gcx, gcz, self.near_flag, wnx, wnz, self.wall_s0,
                                 self.n_active, 0.5 * A * self.h * self.h, clip,
                                 self.shift_dx, self.shift_dz)
-        else:
-            return
         # the density follows the volume change of the shift at the next evaluation
         self.x[:self.n_active] += self.shift_dx[:self.n_active]
         self.z[:self.n_active] += self.shift_dz[:self.n_active]

@@ -164,7 +164,6 @@ def test_checkpoint_key_covers_case_solver_and_threads(monkeypatch):
     from solver import front
     with open(EXAMPLES / "conveyor.yaml") as fh:
         d = yaml.safe_load(fh)
-    from solver.conveyor import case_from_dict
     case = case_from_dict(d)
     key = front.checkpoint_key(case, 2)
     assert key == front.checkpoint_key(case_from_dict(d), 2)
@@ -172,3 +171,31 @@ def test_checkpoint_key_covers_case_solver_and_threads(monkeypatch):
     assert key != front.checkpoint_key(case_from_dict({**d, "cfl": 0.25}), 2)
     monkeypatch.setattr(front, "source_hash", lambda: "another solver")
     assert key != front.checkpoint_key(case, 2)
+
+
+@pytest.mark.parametrize("start", ["block", "lubrication"])
+def test_lubrication_start_velocity_is_the_film_profile_with_zero_flux(start):
+    """u = U (3 (s - s^2/2) - 1) at the local depth: U at the bed (no slip on the belt),
+    U/2 downslope at the surface, and a depth-mean lab velocity of zero in every column."""
+    from solver.conveyor import lubrication_velocity
+    c = paper(start=start, start_velocity="lubrication", dp=1.0e-3)
+    scene = build_scene(c)
+    assert c.running_start and c.ramp_end == 0.0
+    assert all(w.ramp_time == 0.0 and w.ramp_delay == 0.0 for w in scene.walls)
+    z = np.linspace(0.0, 1.0, 2001)
+    for x in (0.5 * c.h_n, 5 * c.h_n, 15 * c.h_n):  # in the taper, and beyond it
+        top = scene.fluid.profiles[0].top(x) if scene.fluid.profiles else c.h_n
+        u, w = lubrication_velocity(c, scene, np.full(z.size, x), z * top)
+        U = -u[0]
+        assert U > 0 and not w.any()
+        assert u[-1] == pytest.approx(0.5 * U)
+        assert abs(np.trapezoid(u, z)) < 1e-6 * U  # trapezoid error of this parabola: 6e-8 U
+    far = lubrication_velocity(c, scene, np.array([15 * c.h_n]), np.array([0.0]))[0]
+    assert far[0] == pytest.approx(-c.belt.speed)
+
+
+def test_start_velocity_is_validated():
+    with pytest.raises(SceneError, match="case.start_velocity.*rest, lubrication"):
+        paper(start_velocity="moving")
+    with pytest.raises(SceneError, match="case.start_velocity: a warm start"):
+        paper(start="warm", warm_from="x.nc", start_velocity="lubrication")

@@ -1,0 +1,120 @@
+"""Projected wall time of config/paper.yaml on this machine, from measured short runs.
+
+Measures, on --threads threads, short runs (--time s of simulated time each, after a compile
+run) of the paper case (examples/conveyor.yaml with the paper grid's settings):
+  - every Ch of the grid with each method at dp = 1 mm (the step rate per Ch and method),
+  - Ch = 1.8 at dp = 0.5 mm and 0.25 mm with each method (how the rate and dt scale).
+Each gives particles N, steps, mean dt and particle-steps/s. A case of the grid then costs
+  wall = T_sim / dt(dp, Ch) * N(dp) / rate(dp, Ch, method)
+with dt and N measured at (dp, Ch = 1.8) and scaled to other Ch by the dp = 1 mm runs
+(dt and rate ratios between Ch at dp = 1 mm), and T_sim the simulated time a case needs:
+its steady time plus averaging window (--t-sim, per method, measured at dp = 1 mm: see
+benchmarks/time_to_solution.py) and, as the upper bound, the grid's max_time.
+
+Usage: python benchmarks/paper_grid.py [--threads 2] [--time 0.05] [--fine-time 0.02]
+           [--t-sim skillen=7.8 lind=12.4] [--out results/paper_grid] [--reuse]
+Prints the measured runs and the projection as Markdown.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numba
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def measure(dp: float, ch: float, method: str, sim_time: float) -> dict:
+    from solver.conveyor import case_from_dict
+    from solver.front import run_front
+    from solver.scene import read_yaml
+    paper = yaml.safe_load((ROOT / "config" / "paper.yaml").read_text())["case"]
+    d = read_yaml(ROOT / "examples" / "conveyor.yaml")
+    d.update({k: v for k, v in paper.items() if k not in ("probes", "steady")})
+    d.update(dp=dp, ch=ch, shifting=method, name=f"dp{dp * 1e3:g}mm_ch{ch:g}_{method}")
+    d["steady"].update(max_time=sim_time)
+    tic = time.perf_counter()
+    ds = run_front(case_from_dict(d))
+    wall = time.perf_counter() - tic
+    steps = int(ds.attrs["steps"])
+    n = int(ds.attrs["n_fluid"]) + int(ds.attrs["n_boundary"])
+    return {"dp": dp, "ch": ch, "shifting": method, "particles": n, "steps": steps,
+            "simulated": float(ds.attrs["simulated_time_s"]), "wall": wall,
+            "dt": float(ds.attrs["simulated_time_s"]) / steps,
+            "rate": n * steps / wall, "c0": float(ds.attrs["c0"])}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--time", type=float, default=0.05)
+    ap.add_argument("--fine-time", type=float, default=0.02, help="simulated time at 0.25 mm")
+    ap.add_argument("--t-sim", nargs="+", default=["skillen=7.8", "lind=12.4"])
+    ap.add_argument("--out", default=str(ROOT / "results" / "paper_grid"))
+    ap.add_argument("--reuse", action="store_true", help="project from OUT/runs.json, measure nothing")
+    a = ap.parse_args(argv)
+    numba.set_num_threads(a.threads)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    grid = yaml.safe_load((ROOT / "config" / "paper.yaml").read_text())
+    chs = grid["grid"]["ch"]
+    paper_ch = grid["grid"].get("paper_ch", 1.8)
+    max_time = grid["case"]["steady"]["max_time"]
+    t_sim = {k: float(v) for k, v in (s.split("=") for s in a.t_sim)}
+    if a.reuse:
+        runs = json.loads((out / "runs.json").read_text())
+    else:
+        measure(0.002, 1.8, "skillen", 0.01)  # compile
+        runs = []
+        for method in ("skillen", "lind"):
+            for ch in chs:
+                runs.append(measure(0.001, ch, method, a.time))
+            runs.append(measure(0.0005, paper_ch, method, a.time))
+            runs.append(measure(0.00025, paper_ch, method, a.fine_time))
+        (out / "runs.json").write_text(json.dumps(runs, indent=1))
+    print("| dp [mm] | Ch | shifting | particles | simulated [s] | steps | dt [s] | wall [s] | M particle-steps/s |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in runs:
+        print(f"| {r['dp'] * 1e3:g} | {r['ch']:g} | {r['shifting']} | {r['particles']} | {r['simulated']:.3f} | "
+              f"{r['steps']} | {r['dt']:.3g} | {r['wall']:.1f} | {r['rate'] / 1e6:.2f} |")
+
+    def run_of(dp, ch, m):
+        return next(r for r in runs if r["dp"] == dp and r["ch"] == ch and r["shifting"] == m)
+
+    # cases of the paper grid: every Ch with skillen, lind at paper_ch
+    cases = [(dp, ch, "skillen") for dp in grid["grid"]["dp"] for ch in chs]
+    cases += [(dp, paper_ch, "lind") for dp in grid["grid"]["dp"]]
+    nu = grid["case"]["viscosity"] / grid["case"]["density"]
+
+    def limit(h, c0):
+        return min(h / c0, h * h / nu)
+
+    total_meas = total_max = 0.0
+    rows = []
+    for dp, ch, m in cases:
+        base = run_of(dp, paper_ch, m)
+        c1, p1 = run_of(0.001, ch, m), run_of(0.001, paper_ch, m)
+        # dt at (dp, Ch): measured at dp = 1 mm; at finer dp the measured dt at paper_ch times
+        # the ratio of the binding limit, min(h / c0, h^2 / nu), between Ch and paper_ch
+        if dp == 0.001:
+            dt = c1["dt"]
+        else:
+            dt = base["dt"] * limit(ch * dp, base["c0"]) / limit(paper_ch * dp, base["c0"])
+        rate = base["rate"] * c1["rate"] / p1["rate"]
+        cost = lambda T: T / dt * base["particles"] / rate  # noqa: E731
+        rows.append((dp, ch, m, dt, rate, cost(t_sim[m]), cost(max_time)))
+        total_meas += cost(t_sim[m])
+        total_max += cost(max_time)
+    print(f"\n| dp [mm] | Ch | shifting | dt [s] | M particle-steps/s | to steady + window [h] | to max_time {max_time:g} s [h] |")
+    print("|---|---|---|---|---|---|---|")
+    for dp, ch, m, dt, rate, c, cm in rows:
+        print(f"| {dp * 1e3:g} | {ch:g} | {m} | {dt:.3g} | {rate / 1e6:.2f} | {c / 3600:.2f} | {cm / 3600:.1f} |")
+    print(f"| total | | | | | {total_meas / 3600:.1f} | {total_max / 3600:.1f} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,74 @@
+"""Where a conveyor run's time goes: cProfile of the paper case, one row per function.
+
+Runs examples/conveyor.yaml (with --set overrides) for --time seconds of simulated time on
+--threads threads after a short compile run, profiles the whole front run (probes,
+monitors, guards and Python glue included) and prints a Markdown table of the functions
+with the most own time per step, then the run's particle-steps/s beside the throughput
+layer's (benchmarks/throughput.py) at the same particle count, Ch and method.
+
+Usage: python benchmarks/profile_case.py [--time 0.4] [--threads 2] [--set shifting=skillen]
+           [--rows 14] [--steps-layer 400]
+"""
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import sys
+import time
+from pathlib import Path
+
+import numba
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--time", type=float, default=0.4)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("--rows", type=int, default=14)
+    ap.add_argument("--steps-layer", type=int, default=400)
+    a = ap.parse_args(argv)
+    numba.set_num_threads(a.threads)
+    from solver.cli import apply_overrides
+    from solver.conveyor import case_from_dict
+    from solver.front import run_front
+    from solver.scene import read_yaml
+    from throughput import measure
+
+    d = apply_overrides(read_yaml(ROOT / "examples" / "conveyor.yaml"), a.set)
+    d["steady"]["max_time"] = 0.02
+    run_front(case_from_dict(d))  # compile
+    d["steady"]["max_time"] = a.time
+    case = case_from_dict(d)
+    prof = cProfile.Profile()
+    tic = time.perf_counter()
+    prof.enable()
+    ds = run_front(case)
+    prof.disable()
+    wall = time.perf_counter() - tic
+    steps = int(ds.attrs["steps"])
+    n = int(ds.attrs["n_fluid"]) + int(ds.attrs["n_boundary"])
+    st = pstats.Stats(prof)
+    rows = sorted(((v[2], v[0], k) for k, v in st.stats.items()), reverse=True)[:a.rows]
+    total = sum(v[2] for v in st.stats.values())
+    print(f"case {case.name}, shifting {case.shifting}, Ch {case.ch}, dp {case.dp:g} m, "
+          f"{n} particles, {steps} steps, {a.threads} threads: {wall:.1f} s wall "
+          f"({1e3 * wall / steps:.2f} ms/step, profiled)\n")
+    print("| function | calls/step | ms/step | share |")
+    print("|---|---|---|---|")
+    for own, calls, (path, line, name) in rows:
+        where = f"{Path(path).parent.name}/{Path(path).name}:{name}" if line else name
+        print(f"| `{where}` | {calls / steps:.2f} | {1e3 * own / steps:.3f} | {100 * own / total:.1f} % |")
+    rate = n * steps / wall
+    layer = measure(case.ch, a.threads, case.shifting, a.steps_layer, n)
+    print(f"\nconveyor run: {rate / 1e6:.2f} M particle-steps/s (profiled); throughput layer at "
+          f"{layer['particles']} particles, same Ch and method: "
+          f"{layer['particle_steps_per_s'] / 1e6:.2f} M; ratio {rate / layer['particle_steps_per_s']:.2f}")
+
+
+if __name__ == "__main__":
+    main()
