@@ -20,7 +20,6 @@ import numba as nb
 import numpy as np
 
 from .cells import neighbour_cell
-
 from .forces import FASTMATH
 from .kernel import grad_factor, w_value
 
