@@ -9,8 +9,7 @@ The run-to-run spread (--spread) is the metric difference between the same case 
 and on 2 threads: the two sum the pair contributions in another order, so round-off starts
 two trajectories of the same physics apart, and whatever a metric changes by between them
 is noise. A variant's metrics count as "equal" to the shipped case's when every difference
-is within that spread (or within 10 % of the shipped value, whichever is larger: one pair of
-runs measures the spread only roughly).
+is within that spread; without --spread no verdict is given.
 
 Usage: python benchmarks/time_to_solution.py [--shifting skillen lind] [--threads 2]
            [--variants shipped ...] [--spread] [--out results/time_to_solution]
@@ -80,9 +79,8 @@ def main(argv=None):
     print("|" + "---|" * (head.count("|") - 1))
     for method, v, m, spread, base in rows:
         verdict = "-"
-        if base is not None and v not in ("shipped", "shipped, 1 thread"):
-            tol = {k: max(spread[k] if spread else 0.0, 0.1 * abs(base[k])) for k in METRICS}
-            verdict = "yes" if all(abs(m[k] - base[k]) <= tol[k] for k in METRICS) else "no"
+        if spread and base is not None and v not in ("shipped", "shipped, 1 thread"):
+            verdict = "yes" if all(abs(m[k] - base[k]) <= spread[k] for k in METRICS) else "no"
         print(f"| {method} | {v} | {m['status']} | {m['steady_at']:.2f} | {m['simulated']:.2f} | "
               f"{m['steps']} | {m['wall']:.0f} | {m['rate'] / 1e6:.2f} | "
               + " | ".join(f"{m[k]:.4f}" for k in METRICS) + f" | {verdict} |")

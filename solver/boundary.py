@@ -30,9 +30,7 @@ def wall_velocities(walls, t: float) -> np.ndarray:
     """(n_walls, 2) imposed velocity of each wall at time t, with its linear ramp."""
     out = np.zeros((max(len(walls), 1), 2))
     for i, w in enumerate(walls):
-        if t == math.inf:
-            f = 1.0
-        elif w.ramp_time > 0:
+        if w.ramp_time > 0:
             f = min(max((t - w.ramp_delay) / w.ramp_time, 0.0), 1.0)
         else:
             f = 1.0 if t >= w.ramp_delay else 0.0

@@ -265,26 +265,20 @@ def build_scene(c: ConveyorCase, warm=None) -> Scene:
     return scene_from_dict(build_scene_dict(c, warm))
 
 
-def belt_speed_at(c: ConveyorCase, x: np.ndarray) -> np.ndarray:
-    """|belt velocity| under x: u_b, and the taper's (k + 1/2)/n u_b near the upstream wall."""
-    n = c.belt.taper_segments if c.belt.taper_length > 0 else 0
-    speed = np.full(np.shape(x), c.belt.speed)
-    for k in range(n):
-        lo = c.dp * round(k * c.belt.taper_length * c.h_n / n / c.dp)
-        hi = c.dp * round((k + 1) * c.belt.taper_length * c.h_n / n / c.dp)
-        speed[(x >= lo) & (x < hi)] = (k + 0.5) / n * c.belt.speed
-    return speed
-
-
 def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.ndarray):
     """Lab-frame (u, w) of the steady film at fluid points: u = U (u*(z/h) - 1), w = 0, with
     u* = 3 (s - s^2/2) of SPEC section 5 at the local depth h of the initial surface and U
-    the belt speed under the point. The depth-mean lab velocity is then zero: no net flux."""
+    the speed of the bed wall under the point (the belt, or its taper near the upstream
+    wall). The depth-mean lab velocity is then zero: no net flux."""
     if scene.fluid.profiles:
         prof = scene.fluid.profiles[0]
         depth = prof.top(x) - prof.base
     else:
         depth = np.full(np.shape(x), c.h_n)
+    speed = np.zeros(np.shape(x))
+    for w in scene.walls:
+        if w.z[1] <= 0.0:  # bed walls: the belt and its taper segments
+            speed[(x >= w.x[0]) & (x < w.x[1])] = -w.velocity[0]
     s = np.clip(z / np.maximum(depth, 1e-12), 0.0, 1.0)
-    u = belt_speed_at(c, x) * (lubrication.belt_velocity(s) - 1.0)
+    u = speed * (lubrication.belt_velocity(s) - 1.0)
     return u, np.zeros_like(u)

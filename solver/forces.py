@@ -72,6 +72,12 @@ def hydrostatic_pair(x):
     return (1.0 + x) ** (1.0 / 7.0) - 1.0, (1.0 - x) ** (1.0 / 7.0) - 1.0
 
 
+@nb.njit(inline="always", cache=True)
+def thread_rows(start, split, t, ncx, ncz):
+    """Particle range [lo, hi) thread t writes: its columns and the next one (half stencil)."""
+    return start[split[t] * ncz], start[min(split[t + 1] + 1, ncx) * ncz]
+
+
 @functools.cache
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
@@ -87,9 +93,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         inv_h = 1.0 / h
         for t in nb.prange(nt):
             at = acc[t]
-            lo = start[split[t] * ncz]
-            hi = start[min(split[t + 1] + 1, ncx) * ncz]
-            at[lo:hi] = 0.0  # this thread writes its columns and the next one
+            lo, hi = thread_rows(start, split, t, ncx, ncz)
+            at[lo:hi] = 0.0
             if periodic and split[t + 1] == ncx:
                 at[0:start[ncz]] = 0.0
             vm = 0.0
@@ -224,8 +229,7 @@ def reduce_accumulators(acc, kind, split, start, ncx, ncz, periodic, gx, gz, out
         for q in range(nq):
             out[q, i] = 0.0
     for t in range(nt):
-        lo = start[split[t] * ncz]
-        hi = start[min(split[t + 1] + 1, ncx) * ncz]
+        lo, hi = thread_rows(start, split, t, ncx, ncz)
         for i in nb.prange(lo, hi):
             for q in range(nq):
                 out[q, i] += acc[t, i, q]

@@ -14,7 +14,8 @@ import numpy as np
 import xarray as xr
 
 from . import steady
-from .conveyor import ConveyorCase, build_scene
+from .build import build_particles
+from .conveyor import ConveyorCase, build_scene, lubrication_velocity
 from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, toe_position
 from .run import Runner
@@ -235,26 +236,16 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
             warm_note = f"fallback to the lubrication start: {exc}"
             if not quiet:
                 print(f"warning: warm start not possible, {warm_note}", file=sys.stderr)
+    if state is None and warm_note:
+        case = replace(case, start="lubrication", warm_from=None)
+    scene = build_scene(case, state)
+    parts = build_particles(scene)
+    f = parts.kind == 0
     if state is not None:
-        from .build import build_particles
-        scene = build_scene(case, state)
-        parts = build_particles(scene)
-        f = parts.kind == 0
         parts.u[f], parts.w[f] = state.velocity_at(parts.x[f], parts.z[f])
-        sim = Simulation(scene, parts)
-    else:
-        if warm_note:
-            case = replace(case, start="lubrication", warm_from=None)
-        scene = build_scene(case)
-        if case.start_velocity == "lubrication":
-            from .build import build_particles
-            from .conveyor import lubrication_velocity
-            parts = build_particles(scene)
-            f = parts.kind == 0
-            parts.u[f], parts.w[f] = lubrication_velocity(case, scene, parts.x[f], parts.z[f])
-            sim = Simulation(scene, parts)
-        else:
-            sim = Simulation(scene)
+    elif case.start_velocity == "lubrication":
+        parts.u[f], parts.w[f] = lubrication_velocity(case, scene, parts.x[f], parts.z[f])
+    sim = Simulation(scene, parts)
     monitor = FrontMonitor(case)
     runner = Runner(scene, sim, monitors=[monitor], final_snapshot=True)
     ckpt = None

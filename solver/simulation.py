@@ -1,7 +1,6 @@
 """A running simulation: particle state kept sorted by cell, one step at a time."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numba as nb
@@ -81,7 +80,7 @@ class Simulation:
         self.moving = np.array([w.moving for w in s.walls] or [False])
         # wall velocities are constant once every ramp has ended
         self.ramps_end = max([w.ramp_delay + w.ramp_time for w in s.walls] or [0.0])
-        self.vwall_final = boundary.wall_velocities(s.walls, math.inf)
+        self.vwall_final = boundary.wall_velocities(s.walls, self.ramps_end)
 
         self.nthreads = nb.get_num_threads()
         self.acc = np.zeros((self.nthreads, self.n, self.nq))
