@@ -42,11 +42,12 @@ def lattice(rect: Rect, dp: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def hydrostatic_density(scene: Scene, z: np.ndarray, top) -> np.ndarray:
-    """Tait density of a column at rest with free surface at ``top`` (bed-normal gravity)."""
+    """Density of a Tait column at rest with free surface at ``top`` (bed-normal gravity g_n):
+    dP/dz = -rho g_n with dP/drho = c0^2 (rho/rho0)^6 makes rho^6 linear in depth d,
+    rho = rho0 (1 + 6 g_n d / c0^2)^(1/6)."""
     rho0, c0 = scene.fluid.density, scene.c0
-    B = c0 * c0 * rho0 / 7.0
-    p = rho0 * (-scene.gravity[1]) * np.maximum(top - z, 0.0)
-    return rho0 * (1.0 + p / B) ** (1.0 / 7.0)
+    d = np.maximum(top - z, 0.0)
+    return rho0 * (1.0 + 6.0 * (-scene.gravity[1]) * d / (c0 * c0)) ** (1.0 / 6.0)
 
 
 def profile_lattice(profile, dp: float) -> tuple[np.ndarray, np.ndarray]:

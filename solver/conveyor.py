@@ -78,6 +78,7 @@ class ConveyorCase(YamlData):
     coefsound: float = 10.0
     cfl: float = 0.2
     density_diffusion: float | None = 0.1
+    density_diffusion_reference: str = "spec"
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
@@ -110,7 +111,7 @@ class ConveyorCase(YamlData):
     def criteria(self) -> SteadyCriteria:
         s = self.steady
         return SteadyCriteria(window=s.window, front_velocity=s.front_velocity, depth=s.depth,
-                              velocity=s.velocity, min_time=self.ramp_end + s.min_time)
+                              velocity=s.velocity, min_time=self.ramp_end + s.min_time, dp=self.dp)
 
 
 def load_case(path) -> ConveyorCase:
@@ -254,7 +255,8 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
         "sound": {"coefsound": c.coefsound, "depth": hn},
         "cfl": c.cfl,
         "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
-                    "density_diffusion": c.density_diffusion, "shifting": shifting},
+                    "density_diffusion": c.density_diffusion,
+                    "density_diffusion_reference": c.density_diffusion_reference, "shifting": shifting},
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,

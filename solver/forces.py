@@ -15,6 +15,10 @@ Density diffusion, the shifting sums and div(dr) are compiled in or out (``make_
 
   drho_a/dt = rho_a sum_b u_ab.gradW_ab V_b + h c0 D_a
   D_a = 2 delta sum_b ((rho_a - rho_b) - rho_ab^H) (r_ab.gradW_ab) / (r^2 + eta^2) V_b
+  rho_ab^H (reference "spec") = rho0 ((1 + rho0 g_n (z_b - z_a) / B)^(1/7) - 1), as SPEC prints it;
+  rho_ab^H (reference "column") = rho0 g_n (z_b - z_a) / c0^2 (rho0 / rho_m)^5, rho_m = (rho_a + rho_b)/2:
+  the Tait column at rest (d rho/dz = -rho0^6 g_n / (c0^2 rho^5), g_n > 0) by the midpoint
+  rule, antisymmetric in a and b and with no residual on such a column (docs/numerics.md)
   du_a/dt = -sum_b m_b (P_a + P_b)/(rho_a rho_b) gradW_ab   (P_a + P_b >= 0 for fluid-wall pairs)
             + sum_b m_b 4 nu (r_ab.gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)) u_ab  (+ g)
   gradC_a = sum_b dp^2 gradW_ab,  div r_a = -sum_b dp^2 r_ab.gradW_ab
@@ -79,13 +83,15 @@ def thread_rows(start, split, t, ncx, ncz):
 
 
 @functools.cache
-def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False):
+def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
+                   column_reference: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
-    divergence (for the density correction) in or out."""
+    divergence (for the density correction) in or out; ``column_reference`` picks the
+    diffusion's rho^H_ab ("column" rather than "spec")."""
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
     def pair_loop(x, z, u, w, rho, p, mass, kind, wnx, wnz, sdx, sdz, start, ncx, ncz, periodic,
-                  period, split, h, nu, hc0, rho0, k_hyd, delta, dp2, acc, vmax):
+                  period, split, h, nu, hc0, rho0, k_hyd, k_col, delta, dp2, acc, vmax):
         nt = split.size - 1
         fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
         eta2 = 0.01 * h * h
@@ -171,11 +177,18 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     vm = vr
                                 if diffusion:
                                     if ka + kb == 0:
-                                        fa, fb = hydrostatic_pair(k_hyd * dz)
                                         g = 2.0 * delta * hc0 * rdotg * inv_r2e
                                         drab = ra - rb
-                                        s_drho += g * (drab - rho0 * fa) * Vb
-                                        drho_b += g * (-drab - rho0 * fb) * Va
+                                        if column_reference:
+                                            rm = 2.0 * rho0 / (ra + rb)
+                                            rm2 = rm * rm
+                                            e = drab - k_col * dz * rm2 * rm2 * rm
+                                            s_drho += g * e * Vb
+                                            drho_b -= g * e * Va
+                                        else:
+                                            fa, fb = hydrostatic_pair(k_hyd * dz)
+                                            s_drho += g * (drab - rho0 * fa) * Vb
+                                            drho_b += g * (-drab - rho0 * fb) * Va
                                 at[b, DRHO] += drho_b
                                 if shifting:
                                     # concentration counts particles: volume dp^2 each

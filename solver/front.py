@@ -22,7 +22,35 @@ from .run import Runner
 from .simulation import Simulation
 from .sources import source_hash
 
-SERIES = ("toe", "uniform_depth", "enclosed_area", "mass_area", "number_density")
+SERIES = ("toe", "front_position", "uniform_depth", "enclosed_area", "mass_area", "number_density")
+ZONES = ("wall", "body", "front", "in_walls")
+WALL_ZONE = 2.0  # h_n: the upstream wall region (the belt taper and the corner flow)
+
+
+def zone_budget(x, z, volume, xs, zs, toe, h_n, front_length):
+    """Area by zone: (enclosed, mass-implied), each over ZONES.
+
+    Zones along the belt: wall (x < WALL_ZONE h_n), front (within ``front_length`` h_n of the
+    toe) and the body between; in_walls holds fluid particles behind the upstream wall or
+    under the belt surface (x < 0 or z < 0), which no enclosed area contains.
+    Enclosed: the trapezoid integral of the free surface zs(xs) over the zone's x range.
+    """
+    edges = np.array([0.0, WALL_ZONE * h_n, toe - front_length * h_n, toe])
+    edges[1:3] = np.clip(edges[1:3], 0.0, toe)
+    xx = np.concatenate([[0.0], xs, [toe]])
+    zz = np.concatenate([[zs[0] if zs.size else 0.0], zs, [0.0]])
+    enclosed = np.zeros(len(ZONES))
+    mass = np.zeros(len(ZONES))
+    for k in range(3):
+        lo, hi = edges[k], edges[k + 1]
+        if hi > lo:
+            xk = np.concatenate([[lo], xx[(xx > lo) & (xx < hi)], [hi]])
+            enclosed[k] = float(np.trapezoid(np.interp(xk, xx, zz), xk))
+    inside = (x >= 0.0) & (z >= 0.0)
+    zone = np.searchsorted(edges[1:3], x, side="right")
+    mass[:3] = np.bincount(zone[inside], weights=volume[inside], minlength=3)[:3]
+    mass[3] = float(volume[~inside].sum())
+    return enclosed, mass
 
 
 class FrontMonitor:
@@ -36,12 +64,20 @@ class FrontMonitor:
         self.x_star = np.round(np.arange(0.0, p.x_star_max + 0.5 * p.x_star_step, p.x_star_step), 10)
         self.z_star = np.round(np.arange(0.0, p.z_star_max + 0.5 * p.z_star_step, p.z_star_step), 10)
         self.stations = np.asarray(p.stations, dtype=float)
-        self.crit = case.criteria()
+        self.tracker = steady.SteadyTracker(case.criteria(), case.belt.speed, case.h_n, case.steady.average)
+        self.state = "transient"
         self.t: list[float] = []
         self.series = {k: [] for k in SERIES}
+        self.zone_enclosed: list[np.ndarray] = []
+        self.zone_mass: list[np.ndarray] = []
+        self.disorder: list[np.ndarray] = []  # (M_xx, M_zz, h |sum V gradW|) in the uniform zone
         self.surface: list[np.ndarray] = []  # z_max over x_star
         self.velocity: list[np.ndarray] = []  # u* over (station, z_star)
-        self.t_steady = math.nan
+
+    @property
+    def t_steady(self) -> float:
+        """Time steady state was detected (NaN: not, or withdrawn)."""
+        return self.tracker.t_steady
 
     # ---- one sample ---------------------------------------------------------------
     def sample(self, sim: Simulation) -> dict:
@@ -56,7 +92,17 @@ class FrontMonitor:
         zs = fs.surface(xs, 0.0)
         enclosed = float(np.trapezoid(np.concatenate([[zs[0]], zs, [0.0]]),
                                       np.concatenate([[0.0], xs, [toe]])))
-        mass_area = float((sim.mass[:n][fl] / sim.rho[:n][fl]).sum())
+        vol = sim.mass[:n][fl] / sim.rho[:n][fl]
+        mass_area = float(vol.sum())
+        zone_enclosed, zone_mass = zone_budget(xf, sim.z[:n][fl], vol, xs, zs, toe, hn,
+                                               c.probes.uniform_zone[0])
+        # front position: the most downstream point where the surface is at half h_n (far less
+        # noisy than the toe, which jumps by dp as particles join or leave the tip)
+        above = np.flatnonzero(zs >= 0.5 * hn)
+        front = math.nan
+        if above.size and above[-1] + 1 < xs.size:
+            k = above[-1]
+            front = float(xs[k] + (zs[k] - 0.5 * hn) / (zs[k] - zs[k + 1]) * (xs[k + 1] - xs[k]))
         x_lab = toe - self.x_star * hn
         surface = np.interp(x_lab, xs, zs, left=np.nan, right=0.0)
         lo, hi = c.probes.uniform_zone
@@ -72,8 +118,17 @@ class FrontMonitor:
         zx = toe - np.linspace(lo, hi, 7) * hn
         nd = fs.points(np.repeat(zx, 3), np.tile(np.array([0.3, 0.45, 0.6]) * depth, zx.size))
         number_density = float(np.mean(nd[4]) * dp * dp) if np.isfinite(depth) else math.nan
-        return {"toe": toe, "uniform_depth": depth, "enclosed_area": enclosed,
+        # particle disorder in the interior of the uniform zone (away from bed and surface)
+        disorder = np.full(3, math.nan)
+        if np.isfinite(depth):
+            xa, za = sim.x[:n], sim.z[:n]
+            core = np.flatnonzero(fl & (xa <= toe - lo * hn) & (xa >= toe - hi * hn)
+                                  & (za >= 2.0 * sim.h) & (za <= depth - 2.0 * sim.h))
+            if core.size:
+                disorder = fs.disorder(core).mean(axis=1)
+        return {"toe": toe, "front_position": front, "uniform_depth": depth, "enclosed_area": enclosed,
                 "mass_area": mass_area, "number_density": number_density,
+                "zone_enclosed": zone_enclosed, "zone_mass": zone_mass, "disorder": disorder,
                 "surface": surface, "velocity": u_star}
 
     def station_means(self) -> np.ndarray:
@@ -88,19 +143,20 @@ class FrontMonitor:
         self.t.append(sim.t)
         for k in SERIES:
             self.series[k].append(s[k])
+        self.zone_enclosed.append(s["zone_enclosed"])
+        self.zone_mass.append(s["zone_mass"])
+        self.disorder.append(s["disorder"])
         self.surface.append(s["surface"])
         self.velocity.append(s["velocity"])
         drift = s["enclosed_area"] / s["mass_area"] - 1.0
         if abs(drift) > self.case.max_area_drift:
             return ("diverged", f"t = {sim.t:.6g} s: enclosed area differs from the mass-implied "
                     f"area by {100 * drift:+.1f} % (max_area_drift = {self.case.max_area_drift:g})")
-        c = self.case
-        if math.isnan(self.t_steady):
-            if steady.is_steady(self.t, self.series["toe"], self.series["uniform_depth"],
-                                self.station_means(), self.crit, c.belt.speed, c.h_n):
-                self.t_steady = sim.t
-        elif c.steady.stop and sim.t >= self.t_steady + c.steady.average - 1e-9:
-            return ("completed", "")
+        if self.state != "steady":
+            self.state = self.tracker.update(self.t, self.series["front_position"],
+                                             self.series["uniform_depth"], self.station_means())
+            if self.state == "steady" and self.case.steady.stop:
+                return ("completed", "")
         return None
 
     # ---- results ---------------------------------------------------------------------
@@ -111,6 +167,8 @@ class FrontMonitor:
         data = {
             "toe_position": (("time",), np.asarray(self.series["toe"]),
                              {"units": "m", "long_name": "toe (downstream end of the fluid), lab frame"}),
+            "front_position": (("time",), np.asarray(self.series["front_position"]),
+                               {"units": "m", "long_name": "most downstream x where the free surface is at h_n / 2, lab frame"}),
             "uniform_depth": (("time",), np.asarray(self.series["uniform_depth"]),
                               {"units": "m", "long_name": "mean free-surface elevation over the uniform zone"}),
             "enclosed_area": (("time",), np.asarray(self.series["enclosed_area"]),
@@ -119,6 +177,13 @@ class FrontMonitor:
                           {"units": "m2", "long_name": "mass-implied area sum m/rho"}),
             "number_density": (("time",), np.asarray(self.series["number_density"]),
                                {"units": "1", "long_name": "interior kernel number density sum W dp^2"}),
+            "zone_enclosed_area": (("time", "zone"), np.asarray(self.zone_enclosed).reshape(t.size, len(ZONES)),
+                                   {"units": "m2", "long_name": "area between bed and free surface in each zone"}),
+            "zone_mass_area": (("time", "zone"), np.asarray(self.zone_mass).reshape(t.size, len(ZONES)),
+                               {"units": "m2", "long_name": "mass-implied area sum m/rho of the fluid particles in each zone"}),
+            "disorder": (("time", "moment"), np.asarray(self.disorder).reshape(t.size, 3),
+                         {"units": "1", "long_name": "mean particle-arrangement moments in the uniform zone's "
+                          "interior: M_xx, M_zz (1 on a lattice) and h |sum_b V_b gradW_ab| (0 on a lattice)"}),
             "surface_elevation": (("time", "x_star"), np.asarray(self.surface).reshape(t.size, -1),
                                   {"units": "m", "long_name": "free surface z_max (C = 0.5 level)"}),
             "velocity_star": (("time", "station", "z_star"),
@@ -130,21 +195,31 @@ class FrontMonitor:
             "x_star": ("x_star", self.x_star, {"units": "1", "long_name": "distance upslope from the toe / h_n"}),
             "station": ("station", self.stations, {"units": "1", "long_name": "station x* upslope from the toe"}),
             "z_star": ("z_star", self.z_star, {"units": "1", "long_name": "bed-normal height / h_n"}),
+            "moment": ("moment", ["M_xx", "M_zz", "grad_sum"]),
+            "zone": ("zone", list(ZONES), {"long_name": f"wall: x < {WALL_ZONE:g} h_n; front: within "
+                                            f"{c.probes.uniform_zone[0]:g} h_n of the toe; body: between; "
+                                            "in_walls: fluid at x < 0 or z < 0"}),
         })
         ds["area_drift"] = (("time",), ds.enclosed_area.values / ds.mass_area.values - 1.0,
                             {"units": "1", "long_name": "enclosed / mass-implied area - 1"})
-        steady_found = bool(np.isfinite(self.t_steady))
-        ds.attrs["steady_state_time_s"] = float(self.t_steady)
-        ds.attrs["steady"] = int(steady_found)
-        # the steady window; without steady state, the final window of the same length,
-        # flagged (attrs steady = 0, averaging) so that nothing passes for a steady result
-        # with steady.stop false (fixed end time) the final window, steady when it starts after
-        # steady state was detected
+        # the averaging window: with steady.stop, the window after detection, steady when the
+        # tracker verified it; otherwise (fixed end time, or no steady state) the final window
+        # of the same length, steady only when steady state was detected before it starts and
+        # the window itself meets the tolerances; a window that is not steady is flagged
+        # (attrs steady = 0, averaging) so that nothing passes for a steady result
         final = t[-1] - c.steady.average if t.size else np.nan
-        if steady_found and not c.steady.stop:
-            steady_found = self.t_steady <= final + 1e-9
-            ds.attrs["steady"] = int(steady_found)
-        start = (self.t_steady if c.steady.stop else final) if steady_found else final
+        if c.steady.stop:
+            steady_found = self.state == "steady"
+            start = self.t_steady if steady_found else final
+        else:
+            start = final
+            steady_found = bool(np.isfinite(self.t_steady) and self.t_steady <= final + 1e-9
+                                and self.tracker.verify(t, self.series["front_position"],
+                                                        self.series["uniform_depth"],
+                                                        self.station_means(), final))
+        ds.attrs["steady_state_time_s"] = float(self.t_steady) if steady_found else math.nan
+        ds.attrs["steady"] = int(steady_found)
+        ds.attrs["steady_withdrawn_s"] = [float(a) for a, _ in self.tracker.rejected] or ""
         ds.attrs["averaging"] = "steady window" if steady_found else "final window, NOT steady"
         if t.size and t[-1] - t[0] >= c.steady.average - 1e-9:
             win = (t >= start - 1e-9) & (t <= start + c.steady.average + 1e-9)
@@ -255,15 +330,19 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         resumed = ckpt.restore(runner)
         monitor = runner.monitors[0]
     res = runner.run(quiet=quiet, on_step=ckpt)
-    if res.status == "completed" and math.isnan(monitor.t_steady):
+    front_ds = monitor.dataset()
+    if res.status == "completed" and not front_ds.attrs["steady"]:
         res.status = "not_steady"
-        res.reason = f"no steady state by max_time = {case.steady.max_time:g} s"
+        withdrawn = front_ds.attrs["steady_withdrawn_s"]
+        res.reason = (f"no steady state by max_time = {case.steady.max_time:g} s"
+                      + (f" (detections at {', '.join(f'{v:.2f}' for v in withdrawn)} s withdrawn: "
+                         "their averaging windows drifted)" if len(withdrawn) else ""))
     run_ds = to_dataset(res)
     # keep only the final snapshot (the particle distribution of the paper's Fig. 7)
     if "snapshot" in run_ds.dims and run_ds.sizes["snapshot"] > 1:
         run_ds = run_ds.isel(snapshot=[-1])
     run_ds = run_ds.rename({"time": "diag_time"})
-    ds = xr.merge([monitor.dataset(), run_ds], combine_attrs="override")
+    ds = xr.merge([front_ds, run_ds], combine_attrs="override")
     ds.attrs.update(run_ds.attrs)
     ds.attrs.update({
         "title": f"sph-surge conveyor-belt front, case '{case.name}'",

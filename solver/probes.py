@@ -99,6 +99,43 @@ def surface_elevation(xs, ztop, zfloor, step, x, z, u, w, rho, mass, kind, start
             zc, c_prev = zn, c
 
 
+@nb.njit(parallel=True, cache=True)
+def disorder_moments(idx, x, z, rho, mass, start, x0, z0, csx, csz, ncx, ncz, periodic, period,
+                     h, out):
+    """At particles idx, with gradW_ab = F r_ab and V = m / rho (fluid and walls):
+    out[:, k] = (M_xx, M_zz, h |sum_b V_b gradW_ab|), M = -sum_b V_b F r_ab r_ab.
+    On a regular lattice M = I and the gradient sum is 0; the viscous term sum_b 2 V F u_ab
+    approximates M : grad grad u + 2 (sum_b V gradW) . grad u, so both measure how far the
+    particle arrangement is from one that makes it the Laplacian."""
+    fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
+    four_h2 = 4.0 * h * h
+    for k in nb.prange(idx.size):
+        a = idx[k]
+        ix = int(math.floor((x[a] - x0) / csx))
+        iz = int(math.floor((z[a] - z0) / csz))
+        mxx = mzz = gx = gz = 0.0
+        for ddx in range(-1, 2):
+            for ddz in range(-1, 2):
+                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                if c < 0:
+                    continue
+                for j in range(start[c], start[c + 1]):
+                    dx = x[a] - (x[j] + shift)
+                    dz = z[a] - z[j]
+                    r2 = dx * dx + dz * dz
+                    if r2 >= four_h2 or j == a:
+                        continue
+                    s = 1.0 - 0.5 * math.sqrt(r2) / h
+                    VF = mass[j] / rho[j] * fac * s * s * s
+                    mxx -= VF * dx * dx
+                    mzz -= VF * dz * dz
+                    gx += VF * dx
+                    gz += VF * dz
+        out[0, k] = mxx
+        out[1, k] = mzz
+        out[2, k] = h * math.sqrt(gx * gx + gz * gz)
+
+
 def toe_position(xf: np.ndarray, dp: float, gap_bins: int = 2) -> float:
     """Downstream end of the fluid body (see module docstring)."""
     if xf.size == 0:
@@ -136,6 +173,15 @@ class FieldSampler:
         pz = np.ascontiguousarray(pz, dtype=float).ravel()
         out = np.empty((5, px.size))
         sample_points(px, pz, *self._grid_args(), out)
+        return out
+
+    def disorder(self, idx) -> np.ndarray:
+        """(M_xx, M_zz, h |sum V gradW|) at the particles idx (see ``disorder_moments``)."""
+        s, g = self.sim, self.sim.grid
+        idx = np.ascontiguousarray(idx, dtype=np.int64)
+        out = np.empty((3, idx.size))
+        disorder_moments(idx, s.x, s.z, s.rho, s.mass, s.start, g.x0, g.z0, g.csx, g.csz,
+                         g.ncx, g.ncz, g.periodic, g.period, s.h, out)
         return out
 
     def surface(self, xs, zfloor: float) -> np.ndarray:

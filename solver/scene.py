@@ -16,6 +16,7 @@ import yaml
 SHIFTING_METHODS = ("none", "skillen", "lind")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
+DIFFUSION_REFERENCES = ("spec", "column")
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
 
 
@@ -132,6 +133,8 @@ class Physics:
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"  # ghost velocity: shepard (SPEC) or corrected (first order)
     density_diffusion: float | None = 0.1  # delta; null/false switches it off
+    # rho^H_ab of the diffusion: spec (SPEC's printed form) or column (the Tait column at rest)
+    density_diffusion_reference: str = "spec"
     shifting: Shifting = field(default_factory=Shifting)
 
 
@@ -366,6 +369,9 @@ def validate(scene: Scene) -> None:
             f"physics.mdbc_velocity: {ph.mdbc_velocity!r} is not one of {', '.join(MDBC_VELOCITY)}")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
+    if ph.density_diffusion_reference not in DIFFUSION_REFERENCES:
+        raise SceneError(f"physics.density_diffusion_reference: {ph.density_diffusion_reference!r} "
+                         f"is not one of {', '.join(DIFFUSION_REFERENCES)}")
     sh = ph.shifting
     if sh.method not in SHIFTING_METHODS:
         raise SceneError(

@@ -68,7 +68,8 @@ class Simulation:
         shifting_on = self.shift_method != "none"
         self.correct_shift = shifting_on and s.shift_density_correction
         self.nq = forces.n_slots(shifting_on, self.correct_shift)
-        self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift)
+        self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
+                                                s.physics.density_diffusion_reference == "column")
         self.sorted_fields = _SORTED + (_SHIFT if self.correct_shift else ())
         self.mdbc = s.physics.boundary == "mdbc"
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected")
@@ -152,7 +153,7 @@ class Simulation:
         self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                        self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.start, g.ncx, g.ncz,
                        g.periodic, g.period, self.split, self.h, self.nu, self.h * self.c0, self.rho0,
-                       self.rho0 * s.gravity[1] / self.B, self.delta, s.dp * s.dp, self.acc, self.vmax_t)
+                       self.rho0 * s.gravity[1] / self.B, self.rho0 * s.gravity[1] / self.c0 ** 2, self.delta, s.dp * s.dp, self.acc, self.vmax_t)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.start, g.ncx, g.ncz,
                                                g.periodic, s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())

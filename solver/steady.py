@@ -1,16 +1,31 @@
 """Steady-state detection on probe time series (pure functions).
 
-Over the trailing window [t_end - window, t_end] each signal is fitted by a straight line
-(least squares); the state is steady when every drift is within its tolerance:
-  front:    |d x_toe / dt|                  <= front_velocity * u_b
-  depth:    |d h_u / dt| * window           <= depth * h_n
-  velocity: |d u*_j / dt| * window          <= velocity    (depth-mean u* at each station)
+Over the trailing window [t_end - window, t_end] each signal y(t) is fitted by a straight
+line (least squares). Its drift over the window, |slope| * window, must be below the
+signal's tolerance with confidence: the upper bound |slope| + Z * se(slope) of the drift
+rate, times the window, must not exceed it. se(slope) comes from the fit's residuals,
+widened for their correlation from sample to sample (effective sample count
+n (1 - r1) / (1 + r1), r1 the lag-1 autocorrelation of the residuals, r1 >= 0). So a trend
+is weighed against the signal's own sampling noise: noise alone lengthens the time to
+detection, never shortens it, and a drift larger than the tolerance never passes however
+noisy the signal.
+
+Tolerances (the probes of a coarse run fluctuate by a fraction of dp, so a tolerance fixed
+in h_n or u_b alone cannot be met at every dp):
+  toe:      drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
+  depth:    drift <= max(depth * h_n, NOISE_DP * dp)
+  velocity: drift of each station's depth-mean u* <= velocity
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+
+Z = 2.0  # detection: confidence multiplier on the slope's standard error
+VERIFY_Z = 1.0  # verification of an averaging window (detection already was confident)
+NOISE_DP = 0.1  # fraction of dp a surface or toe probe may drift over a window, at any dp
 
 
 @dataclass
@@ -20,18 +35,38 @@ class SteadyCriteria:
     depth: float = 0.005  # fraction of h_n over the window
     velocity: float = 0.02  # change of station depth-mean u* over the window
     min_time: float = 0.0  # s: not before (e.g. the end of the belt ramp)
+    dp: float = 0.0  # m: particle spacing, for the noise floor of the tolerances
 
 
 def trend(t: np.ndarray, y: np.ndarray) -> float:
     """Least-squares slope dy/dt (NaN if fewer than 3 finite samples)."""
+    return trend_bound(t, y)[0]
+
+
+def trend_bound(t, y) -> tuple[float, float]:
+    """(slope, standard error of the slope) of the least-squares line, the error widened
+    for lag-1 correlation of the residuals; NaNs if fewer than 3 finite samples."""
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
     ok = np.isfinite(y)
-    if ok.sum() < 3:
-        return np.nan
+    n = int(ok.sum())
+    if n < 3:
+        return math.nan, math.nan
     t, y = t[ok], y[ok]
     tc = t - t.mean()
-    return float((tc * (y - y.mean())).sum() / (tc * tc).sum())
+    stt = float((tc * tc).sum())
+    if stt <= 0:
+        return math.nan, math.nan
+    slope = float((tc * (y - y.mean())).sum() / stt)
+    res = y - y.mean() - slope * tc
+    ss = float((res * res).sum())
+    if n < 4 or ss == 0.0:
+        return slope, 0.0
+    r1 = float((res[1:] * res[:-1]).sum() / ss)
+    r1 = min(max(r1, 0.0), 0.95)
+    n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
+    var = ss / (n - 2) / stt * (n / n_eff)
+    return slope, math.sqrt(var)
 
 
 def window_mask(t: np.ndarray, t_end: float, window: float) -> np.ndarray:
@@ -53,13 +88,89 @@ def drifts(t, toe, depth, station_u, window: float) -> dict[str, float]:
     }
 
 
-def is_steady(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
-    """True when the last ``crit.window`` seconds meet every tolerance (and the samples span
-    the whole window, after ``crit.min_time``)."""
+def tolerances(crit: SteadyCriteria, u_b: float, h_n: float) -> dict[str, float]:
+    """Allowed drift over one window of each signal (see the module docstring)."""
+    floor = NOISE_DP * crit.dp
+    return {"toe": max(crit.front_velocity * u_b * crit.window, floor),
+            "depth": max(crit.depth * h_n, floor),
+            "velocity": crit.velocity}
+
+
+def assess(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float,
+           t_start: float | None = None, z: float = Z) -> dict:
+    """Confident drift bounds against tolerances over [t_start, t_end] (default: the
+    trailing ``crit.window``). Drift bounds are scaled to the span of ``crit.window``, so a
+    longer span (an averaging window) is judged by the same rates.
+
+    Returns {"steady": bool, "ratio": {signal: bound / tolerance}} (ratio <= 1 passes)."""
     t = np.asarray(t, dtype=float)
-    if t.size < 3 or t[-1] - crit.window < max(crit.min_time, t[0]) - 1e-12:
+    start = t[-1] - crit.window if t_start is None else t_start
+    m = (t >= start - 1e-12)
+    tol = tolerances(crit, u_b, h_n)
+    ratio = {}
+    for name, y in (("toe", toe), ("depth", depth)):
+        s, se = trend_bound(t[m], np.asarray(y, dtype=float)[m])
+        ratio[name] = (abs(s) + z * se) * crit.window / tol[name]
+    su = np.asarray(station_u, dtype=float).reshape(len(t), -1)[m]
+    worst = 0.0
+    for j in range(su.shape[1]):
+        s, se = trend_bound(t[m], su[:, j])
+        worst = max(worst, (abs(s) + z * se) * crit.window / tol["velocity"]) if np.isfinite(s) else math.nan
+    ratio["velocity"] = worst
+    ok = all(np.isfinite(v) and v <= 1.0 for v in ratio.values())
+    return {"steady": bool(ok), "ratio": ratio}
+
+
+SPANS = (1, 2, 4)  # trailing spans tried, in windows: a longer span resolves a noisier trend
+
+
+def is_steady(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
+    """True when a trailing span of 1, 2 or 4 windows, after ``crit.min_time``, meets every
+    tolerance with confidence. A noisy signal needs a longer span to show that its drift
+    is small; a real drift fails on every span."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 3:
         return False
-    d = drifts(t, toe, depth, station_u, crit.window)
-    values = (abs(d["front_velocity"]) / u_b, abs(d["depth_change"]) / h_n, d["velocity_change"])
-    limits = (crit.front_velocity, crit.depth, crit.velocity)
-    return all(np.isfinite(v) and v <= lim for v, lim in zip(values, limits))
+    first = max(crit.min_time, t[0])
+    for k in SPANS:
+        start = t[-1] - k * crit.window
+        if start < first - 1e-12:
+            break
+        if assess(t, toe, depth, station_u, crit, u_b, h_n, t_start=start)["steady"]:
+            return True
+    return False
+
+
+class SteadyTracker:
+    """Steady detection followed by verification of the averaging window.
+
+    ``update`` takes the probe series so far. Once ``is_steady`` fires at t_s the run
+    averages over [t_s, t_s + average]; when that window is complete it must itself meet
+    the tolerances (``assess`` from t_s), or the detection is withdrawn (recorded in
+    ``rejected``) and detection starts again. States: "transient", "averaging", "steady".
+    """
+
+    def __init__(self, crit: SteadyCriteria, u_b: float, h_n: float, average: float):
+        self.crit, self.u_b, self.h_n, self.average = crit, u_b, h_n, average
+        self.t_steady = math.nan
+        self.rejected: list[tuple[float, float]] = []  # (detected at, withdrawn at)
+
+    def update(self, t, toe, depth, station_u) -> str:
+        t_end = float(np.asarray(t)[-1])
+        if math.isnan(self.t_steady):
+            if is_steady(t, toe, depth, station_u, self.crit, self.u_b, self.h_n):
+                self.t_steady = t_end
+                return "averaging"
+            return "transient"
+        if t_end < self.t_steady + self.average - 1e-9:
+            return "averaging"
+        if self.verify(t, toe, depth, station_u, self.t_steady):
+            return "steady"
+        self.rejected.append((self.t_steady, t_end))
+        self.t_steady = math.nan
+        return "transient"
+
+    def verify(self, t, toe, depth, station_u, t_start: float) -> bool:
+        """Whether the samples from t_start on meet the tolerances (a fixed-end window)."""
+        return assess(t, toe, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
+                      z=VERIFY_Z)["steady"]
