@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 import xarray as xr
 
-from . import steady
+from . import film_fit, steady
 from .build import build_particles
 from .conveyor import ConveyorCase, build_scene, lubrication_velocity
 from .output import to_dataset
@@ -202,6 +202,15 @@ class FrontMonitor:
         })
         ds["area_drift"] = (("time",), ds.enclosed_area.values / ds.mass_area.values - 1.0,
                             {"units": "1", "long_name": "enclosed / mass-implied area - 1"})
+        # the film fit at the farthest station (x* = 9.7 in the paper's set), 2 h from bed and surface
+        far = self.stations.size - 1
+        depth_far = ds.surface_elevation.sel(x_star=self.stations[far], method="nearest").values / hn
+        nu_ratio, slip = film_fit.fit_series(self.z_star, ds.velocity_star.values[:, far, :], depth_far,
+                                             2.0 * c.ch * c.dp / hn)
+        ds["film_viscosity_ratio"] = (("time",), nu_ratio, {
+            "units": "1", "long_name": f"nu_eff / nu from the curvature of the u* profile at x* = {self.stations[far]:g}"})
+        ds["film_slip"] = (("time",), slip, {
+            "units": "1", "long_name": f"u* at the bed of the fitted profile at x* = {self.stations[far]:g} (0: no slip)"})
         # the averaging window: with steady.stop, the window after detection, steady when the
         # tracker verified it; otherwise (fixed end time, or no steady state) the final window
         # of the same length, steady only when steady state was detected before it starts and

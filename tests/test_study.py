@@ -43,11 +43,24 @@ def test_grid_product_paper_and_extra_cases():
     assert extra[-1].id == "dp2mm_ch1.5_none_x" and not extra[-1].on_grid
     with pytest.raises(ValueError, match="duplicate"):
         expand(g, [{"dp": 0.001, "ch": 1.0, "shifting": "lind"}])
+    kept = expand({**g, "exclude": [{"ch": 1.0, "shifting": "lind"}, {"dp": 0.0005, "ch": 1.8}]})
+    assert {c.id for c in kept} == {"dp1mm_ch1_skillen", "dp1mm_ch1.8_skillen", "dp1mm_ch1.8_lind",
+                                    "dp0.5mm_ch1_skillen"}
+
+
+def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():
+    c = load("config.yaml")
+    c["grid"]["exclude"] = []
+    with pytest.raises(cfgmod.ConfigError) as exc:
+        cfgmod.validate(c)
+    msg = str(exc.value)
+    assert "dp3mm_ch1_lind" in msg and "physics.shifting.method: lind needs ch >= 1.1" in msg
+    assert "8 neighbours" in msg and "skillen or none" in msg
 
 
 def test_configs_validate_and_expand():
     default = cfgmod.validate(load("config.yaml"))
-    assert len(cfgmod.cases(default)) == 30  # 3 dp x 5 Ch x 2 shifting
+    assert len(cfgmod.cases(default)) == 27  # 3 dp x (5 Ch x 2 shifting - lind at Ch 1)
     paper = cfgmod.validate(load("paper.yaml"))
     cs = cfgmod.cases(paper)
     assert len(cs) == 18
@@ -168,7 +181,7 @@ def dry_run(configfile, tmp_path):
     return counts
 
 
-@pytest.mark.parametrize("name, n", [("config.yaml", 30), ("paper.yaml", 18)])
+@pytest.mark.parametrize("name, n", [("config.yaml", 27), ("paper.yaml", 18)])
 def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     counts = dry_run(ROOT / "config" / name, tmp_path)
     assert counts["run_case"] == n and counts["metrics"] == n and counts["case_file"] == n

@@ -40,14 +40,24 @@ class Case:
 
 def expand(grid: dict, extra: list[dict] | None = None) -> list[Case]:
     """Cases of the grid (``combine``: product, or paper = every Ch with the first shifting
-    method plus every method at ``paper_ch``) followed by the extra cases; ids unique."""
+    method plus every method at ``paper_ch``), less those matching an ``exclude`` entry,
+    followed by the extra cases; ids unique."""
     dps, chs, shifts = grid["dp"], grid["ch"], grid["shifting"]
     combine = grid.get("combine", "product")
+    excluded = grid.get("exclude") or []
+
+    def left_out(dp, ch, sh):
+        values = {"dp": dp, "ch": ch, "shifting": sh}
+        return any(all(values[k] == (v if k == "shifting" else float(v)) for k, v in e.items())
+                   for e in excluded)
+
     cases = []
     for dp in dps:
         for ch in chs:
             for sh in shifts:
                 if combine == "paper" and sh != shifts[0] and ch != grid.get("paper_ch", 1.8):
+                    continue
+                if left_out(float(dp), float(ch), sh):
                     continue
                 cases.append(Case(float(dp), float(ch), sh))
     for e in extra or []:
