@@ -1,7 +1,8 @@
-"""Time integration: symplectic position Verlet (drift-kick-drift), one force evaluation a step.
+"""Time integration: drift-kick-drift, one force evaluation a step.
 
   r^{n+1/2}   = r^n + dt/2 v^n,            rho^{n+1/2} = rho^n + dt/2 (drho/dt)^{n-1/2}
-  forces, drho/dt and shifting sums at n+1/2
+  forces, drho/dt and shifting sums at r^{n+1/2}, rho^{n+1/2} and v^n (first order in time
+  for the velocity-dependent terms)
   v^{n+1}     = v^n + dt a^{n+1/2},        rho^{n+1}   = rho^n + dt (drho/dt)^{n+1/2}
   r^{n+1}     = r^{n+1/2} + dt/2 v^{n+1} (+ shifting)
   dt          = C_CFL min(sqrt(h / max|a|), h / (c0 + max|h u_ab.r_ab/(r^2+eta^2)|), h^2 / nu)
