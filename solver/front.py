@@ -131,6 +131,25 @@ class FrontMonitor:
                 "zone_enclosed": zone_enclosed, "zone_mass": zone_mass, "disorder": disorder,
                 "surface": surface, "velocity": u_star}
 
+    def why_not_steady(self) -> str:
+        """Which signals fail their tolerance over the final window, by how much, and which
+        detections were withdrawn."""
+        t = np.asarray(self.t)
+        if t.size < 3:
+            return "too few probe samples"
+        r = steady.assess(t, self.series["front_position"], self.series["uniform_depth"],
+                          self.station_means(), self.tracker.crit, self.case.belt.speed, self.case.h_n,
+                          t_start=t[-1] - self.case.steady.average)["ratio"]
+        names = {"toe": "front position", "depth": "uniform depth", "velocity": "station velocity"}
+        failing = [f"{names[k]} {v:.1f}x" for k, v in r.items() if not (np.isfinite(v) and v <= 1.0)]
+        text = ("over the final window, drift bound / tolerance: " + ", ".join(failing)) if failing else \
+            "the final window meets the tolerances but steady state was detected too late to average"
+        withdrawn = [a for a, _ in self.tracker.rejected]
+        if withdrawn:
+            text += (f"; detections at {', '.join(f'{v:.2f}' for v in withdrawn)} s withdrawn "
+                     "(their averaging windows drifted)")
+        return text
+
     def station_means(self) -> np.ndarray:
         """Depth-mean u* of each station over time, (time, station)."""
         v = np.asarray(self.velocity)
@@ -342,10 +361,7 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     front_ds = monitor.dataset()
     if res.status == "completed" and not front_ds.attrs["steady"]:
         res.status = "not_steady"
-        withdrawn = front_ds.attrs["steady_withdrawn_s"]
-        res.reason = (f"no steady state by max_time = {case.steady.max_time:g} s"
-                      + (f" (detections at {', '.join(f'{v:.2f}' for v in withdrawn)} s withdrawn: "
-                         "their averaging windows drifted)" if len(withdrawn) else ""))
+        res.reason = f"no steady state by max_time = {case.steady.max_time:g} s: " + monitor.why_not_steady()
     run_ds = to_dataset(res)
     # keep only the final snapshot (the particle distribution of the paper's Fig. 7)
     if "snapshot" in run_ds.dims and run_ds.sizes["snapshot"] > 1:
