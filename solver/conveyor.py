@@ -79,6 +79,7 @@ class ConveyorCase(YamlData):
     cfl: float = 0.2
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
+    viscous_correction: bool = False
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
@@ -256,7 +257,8 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
         "cfl": c.cfl,
         "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
                     "density_diffusion": c.density_diffusion,
-                    "density_diffusion_reference": c.density_diffusion_reference, "shifting": shifting},
+                    "density_diffusion_reference": c.density_diffusion_reference,
+                    "viscous_correction": c.viscous_correction, "shifting": shifting},
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,

@@ -136,6 +136,8 @@ class Physics:
     density_diffusion: float | None = 0.1  # delta; null/false switches it off
     # rho^H_ab of the diffusion: spec (SPEC's printed form) or column (the Tait column at rest)
     density_diffusion_reference: str = "spec"
+    # remove the laminar term's first-order error 2 nu G . grad u where the support is full
+    viscous_correction: bool = False
     shifting: Shifting = field(default_factory=Shifting)
 
 

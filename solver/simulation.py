@@ -67,9 +67,11 @@ class Simulation:
         self.shift_method = s.physics.shifting.method
         shifting_on = self.shift_method != "none"
         self.correct_shift = shifting_on and s.shift_density_correction
-        self.nq = forces.n_slots(shifting_on, self.correct_shift)
+        self.viscous_correction = bool(s.physics.viscous_correction)
+        self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction)
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
-                                                s.physics.density_diffusion_reference == "column")
+                                                s.physics.density_diffusion_reference == "column",
+                                                self.viscous_correction)
         self.sorted_fields = _SORTED + (_SHIFT if self.correct_shift else ())
         self.mdbc = s.physics.boundary == "mdbc"
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected")
@@ -157,6 +159,8 @@ class Simulation:
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.start, g.ncx, g.ncz,
                                                g.periodic, s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
+        if self.viscous_correction:
+            forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active)
         if self.correct_shift:
             self._correct_density()
         return ""
