@@ -71,7 +71,7 @@ def test_spec_reference_leaves_a_bulk_density_sink_on_a_column_at_rest():
     """SPEC's rho^H_ab = rho0 ((1 + x)^(1/7) - 1) is exact only for a pair whose upper
     particle is at zero pressure: its curvature in z_b - z_a has the opposite sign to the
     Tait column's. In the bulk the sum leaves drho/dt / rho = -11 delta h g^2 / c0^3
-    (the kernel-sum Laplacian of the 11/49 rho0 k^2 dz^2 mismatch, k = 7 g / c0^2), and
+    (the kernel-sum Laplacian of the (11/98) rho0 k^2 dz^2 mismatch, k = 7 g / c0^2), and
     the one-sided sums at the bed and surface rows leave more. Checked to 5 %."""
     for dp, ch in ((2e-3, 1.5), (1e-3, 1.8)):
         rate, z, bulk = diffusion_rate_at_rest("spec", dp, ch)
