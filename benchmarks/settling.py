@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
+import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
@@ -86,7 +87,7 @@ def windows(ds: xr.Dataset, start: float) -> list[dict]:
 
 def report(path: str, markdown: bool) -> None:
     ds = xr.open_dataset(path)
-    case = case_from_dict(__import__("yaml").safe_load(ds.attrs["case_yaml"]))
+    case = case_from_dict(yaml.safe_load(ds.attrs["case_yaml"]))
     t_det, withdrawn = replay(ds, case)
     start = t_det if np.isfinite(t_det) else WINDOW
     rows = windows(ds, start)

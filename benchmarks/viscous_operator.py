@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 import xarray as xr
+import yaml
 
 
 def operator_response(x, z, kind, rho, mass, h, nu, g_s, depth, bands):
@@ -68,7 +69,7 @@ def report(path):
     ds = xr.open_dataset(path)
     hn, dp, h = ds.attrs["h_n_m"], float(ds.attrs["dp"]), float(ds.attrs["h"])
     rho0 = float(ds.attrs["rho0"])
-    case = __import__("yaml").safe_load(ds.attrs["case_yaml"])
+    case = yaml.safe_load(ds.attrs["case_yaml"])
     nu = case.get("viscosity", 5.6) / case.get("density", rho0)
     g_s = case.get("gravity", 9.81) * math.sin(math.radians(case.get("slope_deg", 15.3)))
     s = ds.isel(snapshot=-1)

@@ -302,7 +302,8 @@ def correct_viscous_term(out, kind, nu, n):
     makes the term too weak (13 % in the body of the paper case at dp = 1 mm with skillen,
     benchmarks/viscous_operator.py). For fluid particles with div r >= 1.9 (away from the free
     surface, where G measures the missing neighbours rather than disorder) subtract
-    2 nu G . grad u, grad u = sum_b V_b (u_b - u_a) gradW_ab."""
+    2 nu G . grad u, grad u = sum_b V_b (u_b - u_a) gradW_ab. Applied after the reduction:
+    the force limit dt1 of the step uses max |a| before this correction."""
     for i in nb.prange(n):
         if kind[i] != 0 or out[VDIVR, i] < VISCOUS_CORRECTION_MIN_DIVR:
             continue
