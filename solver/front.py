@@ -140,7 +140,7 @@ class FrontMonitor:
         r = steady.assess(t, self.series["front_position"], self.series["uniform_depth"],
                           self.station_means(), self.tracker.crit, self.case.belt.speed, self.case.h_n,
                           t_start=t[-1] - self.case.steady.average)["ratio"]
-        names = {"toe": "front position", "depth": "uniform depth", "velocity": "station velocity"}
+        names = {"front": "front position", "depth": "uniform depth", "velocity": "station velocity"}
         failing = [f"{names[k]} {v:.1f}x" for k, v in r.items() if not (np.isfinite(v) and v <= 1.0)]
         text = ("over the final window, drift bound / tolerance: " + ", ".join(failing)) if failing else \
             "the final window meets the tolerances but steady state was detected too late to average"

@@ -12,7 +12,7 @@ noisy the signal.
 
 Tolerances (the probes of a coarse run fluctuate by a fraction of dp, so a tolerance fixed
 in h_n or u_b alone cannot be met at every dp):
-  toe:      drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
+  front:    drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
   depth:    drift <= max(depth * h_n, NOISE_DP * dp)
   velocity: drift of each station's depth-mean u* <= velocity
 """
@@ -91,12 +91,12 @@ def drifts(t, toe, depth, station_u, window: float) -> dict[str, float]:
 def tolerances(crit: SteadyCriteria, u_b: float, h_n: float) -> dict[str, float]:
     """Allowed drift over one window of each signal (see the module docstring)."""
     floor = NOISE_DP * crit.dp
-    return {"toe": max(crit.front_velocity * u_b * crit.window, floor),
+    return {"front": max(crit.front_velocity * u_b * crit.window, floor),
             "depth": max(crit.depth * h_n, floor),
             "velocity": crit.velocity}
 
 
-def assess(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float,
+def assess(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float,
            t_start: float | None = None, z: float = Z) -> dict:
     """Confident drift bounds against tolerances over [t_start, t_end] (default: the
     trailing ``crit.window``). Drift bounds are scaled to the span of ``crit.window``, so a
@@ -108,7 +108,7 @@ def assess(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: floa
     m = (t >= start - 1e-12)
     tol = tolerances(crit, u_b, h_n)
     ratio = {}
-    for name, y in (("toe", toe), ("depth", depth)):
+    for name, y in (("front", front), ("depth", depth)):
         s, se = trend_bound(t[m], np.asarray(y, dtype=float)[m])
         ratio[name] = (abs(s) + z * se) * crit.window / tol[name]
     su = np.asarray(station_u, dtype=float).reshape(len(t), -1)[m]
@@ -124,7 +124,7 @@ def assess(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: floa
 SPANS = (1, 2, 4)  # trailing spans tried, in windows: a longer span resolves a noisier trend
 
 
-def is_steady(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
+def is_steady(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
     """True when a trailing span of 1, 2 or 4 windows, after ``crit.min_time``, meets every
     tolerance with confidence. A noisy signal needs a longer span to show that its drift
     is small; a real drift fails on every span."""
@@ -136,7 +136,7 @@ def is_steady(t, toe, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: f
         start = t[-1] - k * crit.window
         if start < first - 1e-12:
             break
-        if assess(t, toe, depth, station_u, crit, u_b, h_n, t_start=start)["steady"]:
+        if assess(t, front, depth, station_u, crit, u_b, h_n, t_start=start)["steady"]:
             return True
     return False
 
@@ -155,22 +155,22 @@ class SteadyTracker:
         self.t_steady = math.nan
         self.rejected: list[tuple[float, float]] = []  # (detected at, withdrawn at)
 
-    def update(self, t, toe, depth, station_u) -> str:
+    def update(self, t, front, depth, station_u) -> str:
         t_end = float(np.asarray(t)[-1])
         if math.isnan(self.t_steady):
-            if is_steady(t, toe, depth, station_u, self.crit, self.u_b, self.h_n):
+            if is_steady(t, front, depth, station_u, self.crit, self.u_b, self.h_n):
                 self.t_steady = t_end
                 return "averaging"
             return "transient"
         if t_end < self.t_steady + self.average - 1e-9:
             return "averaging"
-        if self.verify(t, toe, depth, station_u, self.t_steady):
+        if self.verify(t, front, depth, station_u, self.t_steady):
             return "steady"
         self.rejected.append((self.t_steady, t_end))
         self.t_steady = math.nan
         return "transient"
 
-    def verify(self, t, toe, depth, station_u, t_start: float) -> bool:
+    def verify(self, t, front, depth, station_u, t_start: float) -> bool:
         """Whether the samples from t_start on meet the tolerances (a fixed-end window)."""
-        return assess(t, toe, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
+        return assess(t, front, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
                       z=VERIFY_Z)["steady"]
