@@ -1,8 +1,18 @@
-"""Identity of the solver's code: a hash of its sources."""
+"""Identity of the solver's code (a hash of its sources) and the numba cache keyed on it.
+
+Numba's on-disk cache checks only the source file of the function it compiled, not the
+helpers inlined into it from other modules (``kernel.grad_factor`` inside the pair loop of
+``forces``). Editing such a helper could then load stale machine code. So every solver
+process caches its kernels in a directory named by the hash of all solver sources:
+``$SPH_SURGE_CACHE_DIR/numba-<hash>`` (default base ``$XDG_CACHE_HOME/sph-surge``, else
+``~/.cache/sph-surge``). Any change to any solver file compiles afresh.
+"""
 from __future__ import annotations
 
 import functools
 import hashlib
+import os
+import sys
 from pathlib import Path
 
 
@@ -13,3 +23,26 @@ def source_hash() -> str:
     for f in sorted(Path(__file__).parent.glob("*.py")):
         h.update(f.name.encode() + f.read_bytes())
     return h.hexdigest()[:16]
+
+
+def cache_base() -> Path:
+    base = os.environ.get("SPH_SURGE_CACHE_DIR")
+    if base:
+        return Path(base).resolve()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "sph-surge"
+
+
+def numba_cache_dir() -> Path:
+    """Where this solver's compiled kernels live: one directory per source hash."""
+    return cache_base() / f"numba-{source_hash()}"
+
+
+def use_keyed_numba_cache() -> Path:
+    """Point numba's cache at ``numba_cache_dir()``; must run before any kernel is defined.
+    A NUMBA_CACHE_DIR set by the user is replaced: it would not be keyed on the sources."""
+    path = str(numba_cache_dir())
+    os.environ["NUMBA_CACHE_DIR"] = path
+    if "numba" in sys.modules:  # already imported: its config has read the environment
+        sys.modules["numba"].config.CACHE_DIR = path
+    return Path(path)
