@@ -1,5 +1,5 @@
 # sph-surge convergence campaign: snakemake --cores 2 [--configfile config/paper.yaml]
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
 
 min_version("8.0")
 

@@ -105,11 +105,12 @@ def main(argv=None):
         else:
             dt = base["dt"] * limit(ch * dp, base["c0"]) / limit(paper_ch * dp, base["c0"])
         rate = base["rate"] * c1["rate"] / p1["rate"]
-        cost = lambda T: T / dt * base["particles"] / rate  # noqa: E731
-        rows.append((dp, ch, m, dt, rate, cost(t_sim[m]), cost(max_time)))
-        total_meas += cost(t_sim[m])
-        total_max += cost(max_time)
-    print(f"\n| dp [mm] | Ch | shifting | dt [s] | M particle-steps/s | to steady + window [h] | to max_time {max_time:g} s [h] |")
+        per_second = base["particles"] / (dt * rate)  # wall s per simulated s
+        rows.append((dp, ch, m, dt, rate, t_sim[m] * per_second, max_time * per_second))
+        total_meas += t_sim[m] * per_second
+        total_max += max_time * per_second
+    print("\n| dp [mm] | Ch | shifting | dt [s] | M particle-steps/s | to steady + window [h] | "
+          f"to max_time {max_time:g} s [h] |")
     print("|---|---|---|---|---|---|---|")
     for dp, ch, m, dt, rate, c, cm in rows:
         print(f"| {dp * 1e3:g} | {ch:g} | {m} | {dt:.3g} | {rate / 1e6:.2f} | {c / 3600:.2f} | {cm / 3600:.1f} |")

@@ -123,7 +123,8 @@ def main(argv=None):
     plan = {
         "coarse": (f"coarse_{ctag}", [coarse] + base[:1] + [f"steady.max_time={a.coarse_max_time:g}"]),
         "default": (f"default_{tag}", [fine] + base),
-        "fixed_end": (f"fixed_end_{tag}", [fine] + base[:1] + [f"steady.max_time={a.fixed_end:g}", "steady.stop=false"]),
+        "fixed_end": (f"fixed_end_{tag}",
+                      [fine] + base[:1] + [f"steady.max_time={a.fixed_end:g}", "steady.stop=false"]),
         "block": (f"block_{tag}", [fine] + base + ["start=block"]),
         "warm": (f"warm_{tag}", [fine] + base + ["start=warm", f"warm_from={out / ('coarse_' + ctag + '.nc')}"]),
     }

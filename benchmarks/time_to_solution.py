@@ -77,14 +77,14 @@ def main(argv=None):
             "M particle-steps/s | " + " | ".join(METRICS) + " | equal to shipped |")
     print(head)
     print("|" + "---|" * (head.count("|") - 1))
-    for method, v, m, spread, base in rows:
+    for method, v, _, spread, _ in rows:
         verdict = "-"
         if spread and base is not None and v not in ("shipped", "shipped, 1 thread"):
             verdict = "yes" if all(abs(m[k] - base[k]) <= spread[k] for k in METRICS) else "no"
         print(f"| {method} | {v} | {m['status']} | {m['steady_at']:.2f} | {m['simulated']:.2f} | "
               f"{m['steps']} | {m['wall']:.0f} | {m['rate'] / 1e6:.2f} | "
               + " | ".join(f"{m[k]:.4f}" for k in METRICS) + f" | {verdict} |")
-    for method, v, m, spread, base in rows:
+    for method, v, _, spread, _ in rows:
         if spread and v == "shipped":
             print(f"\nrun-to-run spread ({method}, 1 against {a.threads} threads): "
                   + ", ".join(f"{k} {spread[k]:.4f}" for k in METRICS))

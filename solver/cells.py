@@ -11,9 +11,6 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-OUTSIDE = -1
-
-
 @dataclass(frozen=True)
 class Grid:
     x0: float

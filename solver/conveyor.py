@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import lubrication
-from .scene import Scene, SceneError, YamlData, parse_into, read_yaml, scene_from_dict
+from .scene import Scene, SceneError, YamlData, parse_into, scene_from_dict
 from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication", "warm")
@@ -113,10 +113,6 @@ class ConveyorCase(YamlData):
         s = self.steady
         return SteadyCriteria(window=s.window, front_velocity=s.front_velocity, depth=s.depth,
                               velocity=s.velocity, min_time=self.ramp_end + s.min_time, dp=self.dp)
-
-
-def load_case(path) -> ConveyorCase:
-    return case_from_dict(read_yaml(path))
 
 
 def case_from_dict(data) -> ConveyorCase:

@@ -187,7 +187,8 @@ class FrontMonitor:
             "toe_position": (("time",), np.asarray(self.series["toe"]),
                              {"units": "m", "long_name": "toe (downstream end of the fluid), lab frame"}),
             "front_position": (("time",), np.asarray(self.series["front_position"]),
-                               {"units": "m", "long_name": "most downstream x where the free surface is at h_n / 2, lab frame"}),
+                               {"units": "m",
+                                "long_name": "most downstream x where the free surface is at h_n / 2, lab frame"}),
             "uniform_depth": (("time",), np.asarray(self.series["uniform_depth"]),
                               {"units": "m", "long_name": "mean free-surface elevation over the uniform zone"}),
             "enclosed_area": (("time",), np.asarray(self.series["enclosed_area"]),
@@ -199,7 +200,8 @@ class FrontMonitor:
             "zone_enclosed_area": (("time", "zone"), np.asarray(self.zone_enclosed).reshape(t.size, len(ZONES)),
                                    {"units": "m2", "long_name": "area between bed and free surface in each zone"}),
             "zone_mass_area": (("time", "zone"), np.asarray(self.zone_mass).reshape(t.size, len(ZONES)),
-                               {"units": "m2", "long_name": "mass-implied area sum m/rho of the fluid particles in each zone"}),
+                               {"units": "m2",
+                                "long_name": "mass-implied area sum m/rho of the fluid particles in each zone"}),
             "disorder": (("time", "moment"), np.asarray(self.disorder).reshape(t.size, 3),
                          {"units": "1", "long_name": "mean particle-arrangement moments in the uniform zone's "
                           "interior: M_xx, M_zz (1 on a lattice) and h |sum_b V_b gradW_ab| (0 on a lattice)"}),
@@ -227,9 +229,11 @@ class FrontMonitor:
         nu_ratio, slip = film_fit.fit_series(self.z_star, ds.velocity_star.values[:, far, :], depth_far,
                                              2.0 * c.ch * c.dp / hn)
         ds["film_viscosity_ratio"] = (("time",), nu_ratio, {
-            "units": "1", "long_name": f"nu_eff / nu from the curvature of the u* profile at x* = {self.stations[far]:g}"})
+            "units": "1",
+            "long_name": f"nu_eff / nu from the curvature of the u* profile at x* = {self.stations[far]:g}"})
         ds["film_slip"] = (("time",), slip, {
-            "units": "1", "long_name": f"u* at the bed of the fitted profile at x* = {self.stations[far]:g} (0: no slip)"})
+            "units": "1",
+            "long_name": f"u* at the bed of the fitted profile at x* = {self.stations[far]:g} (0: no slip)"})
         # the averaging window: with steady.stop, the window after detection, steady when the
         # tracker verified it; otherwise (fixed end time, or no steady state) the final window
         # of the same length, steady only when steady state was detected before it starts and
@@ -254,12 +258,14 @@ class FrontMonitor:
             tw = t[win]
             avg = ds.isel(time=win).mean("time")
             for k in ("surface_elevation", "velocity_star", "uniform_depth", "number_density", "area_drift"):
-                ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name=ds.attrs["averaging"] + " mean of " + ds[k].attrs["long_name"])
+                long_name = ds.attrs["averaging"] + " mean of " + ds[k].attrs["long_name"]
+                ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name=long_name)
             d = steady.drifts(tw, ds.toe_position.values[win], ds.uniform_depth.values[win],
                               self.station_means()[win], tw[-1] - tw[0])
             last_second = tw >= tw[-1] - 1.0 - 1e-9
             ds["front_velocity"] = ((), steady.trend(tw[last_second], ds.toe_position.values[win][last_second]),
-                                    {"units": "m s-1", "long_name": "toe velocity over the last second of the window, lab frame"})
+                                    {"units": "m s-1",
+                                     "long_name": "toe velocity over the last second of the window, lab frame"})
             ds.attrs["average_window_s"] = float(tw[-1] - tw[0])
             ds.attrs["window_front_velocity_over_ub"] = float(d["front_velocity"] / c.belt.speed)
             ds.attrs["window_depth_change_over_hn"] = float(d["depth_change"] / hn)

@@ -131,7 +131,8 @@ def test_warm_start_fills_the_coarse_state(tmp_path):
     # the fine lattice fills the coarse fluid's area, to half a fine dp per column
     assert f.sum() * c.dp ** 2 == pytest.approx(area, abs=0.5 * c.dp * 0.3)
     u, w = state.velocity_at(p.x[f], p.z[f])
-    inside = (p.z[f] > 2 * state.h) & (p.z[f] < 0.04 - 2 * state.h) & (p.x[f] > 2 * state.h) & (p.x[f] < 0.3 - 2 * state.h)
+    h2 = 2 * state.h
+    inside = (p.z[f] > h2) & (p.z[f] < 0.04 - h2) & (p.x[f] > h2) & (p.x[f] < 0.3 - h2)
     assert inside.sum() > 100
     # Shepard interpolation of a linear field where the coarse kernel is full: exact up to
     # the kernel's first moment off the lattice, held here to 0.5 % of a coarse dp
@@ -155,7 +156,8 @@ def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
               steady={"max_time": 0.05, "window": 0.02, "average": 1.0}, probes={"interval": 0.004})
     ds = run_front(c)
     assert ds.attrs["status"] == "not_steady"
-    assert ds.attrs["warm_start"].startswith("fallback to the lubrication start") and "diverged" in ds.attrs["warm_start"]
+    assert ds.attrs["warm_start"].startswith("fallback to the lubrication start")
+    assert "diverged" in ds.attrs["warm_start"]
     assert "start: lubrication" in ds.attrs["case_yaml"]
 
 

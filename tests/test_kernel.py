@@ -25,8 +25,9 @@ def test_gradient_matches_finite_differences():
     pts = pts[(np.hypot(*pts.T) < 1.95 * h) & (np.hypot(*pts.T) > 0.05 * h)]
     eps = 1e-6 * h
     gx, gz = kernel_gradient(pts[:, 0], pts[:, 1], h)
-    fdx = (kernel(np.hypot(pts[:, 0] + eps, pts[:, 1]), h) - kernel(np.hypot(pts[:, 0] - eps, pts[:, 1]), h)) / (2 * eps)
-    fdz = (kernel(np.hypot(pts[:, 0], pts[:, 1] + eps), h) - kernel(np.hypot(pts[:, 0], pts[:, 1] - eps), h)) / (2 * eps)
+    x, z = pts[:, 0], pts[:, 1]
+    fdx = (kernel(np.hypot(x + eps, z), h) - kernel(np.hypot(x - eps, z), h)) / (2 * eps)
+    fdz = (kernel(np.hypot(x, z + eps), h) - kernel(np.hypot(x, z - eps), h)) / (2 * eps)
     scale = np.abs(fdx).max()
     np.testing.assert_allclose(gx, fdx, atol=1e-7 * scale)
     np.testing.assert_allclose(gz, fdz, atol=1e-7 * scale)

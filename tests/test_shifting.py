@@ -155,7 +155,8 @@ def test_lind_density_correction_is_limited_per_step():
     """Round-off in a channel at rest: a full per-step correction erases the compression the
     pressure needs and the density error grows to the 10 % guard (measured: step 454); the
     default limit of 1e-3 per step keeps it below 0.5 % (measured: 0.19 %)."""
-    assert Simulation(example_scene("channel", physics={"shifting": {"method": "lind"}})).scene.shift_correction_limit == 1e-3
+    sim = Simulation(example_scene("channel", physics={"shifting": {"method": "lind"}}))
+    assert sim.scene.shift_correction_limit == 1e-3
     err, reason = rest_density_error(1e-3)
     assert reason == "" and err < 0.005, (err, reason)
     err, reason = rest_density_error(1e9)

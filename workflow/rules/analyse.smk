@@ -6,8 +6,10 @@ rule metrics:
     params:
         settings=lambda wc: yaml.safe_dump({k: config[k] for k in ("reference", "metrics")}),
         config=CONFIG_FILE,
+    log:
+        "results/logs/metrics_{case}.log",
     shell:
-        "python -m study metrics {params.config} {input} -o {output}"
+        "python -m study metrics {params.config} {input} -o {output} 2> {log}"
 
 
 rule campaign:
@@ -18,5 +20,7 @@ rule campaign:
         "results/campaign.nc",
     params:
         config=CONFIG_FILE,
+    log:
+        "results/logs/campaign.log",
     shell:
-        "python -m study reduce {params.config} --results results/cases -o {output}"
+        "python -m study reduce {params.config} --results results/cases -o {output} 2> {log}"

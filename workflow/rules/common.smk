@@ -1,11 +1,10 @@
 # Config validation (schema, then what a schema cannot check) before any job starts,
 # and the case grid.
 import yaml
-from study.config import SCHEMA, validate as validate_campaign, cases as campaign_cases, case_dict, run_path, warm_source
+from study.config import validate as validate_campaign, cases as campaign_cases, case_dict, run_path, warm_source
 from study.grid import CASE_ID
 
-validate(config, str(SCHEMA))
-config = validate_campaign(config)
+config = validate_campaign(config)  # the schema (with its defaults), then what it cannot check
 CASES = campaign_cases(config)
 CASE_IDS = [c.id for c in CASES]
 CASE_BY_ID = {c.id: c for c in CASES}
@@ -20,9 +19,9 @@ def _write_if_changed(path, text):
     old = open(path).read() if os.path.exists(path) else None
     if old != text:
         os.makedirs(os.path.dirname(path), exist_ok=True)
-        with open(path + ".tmp", "w") as fh:
+        with open(f"{path}.tmp", "w") as fh:
             fh.write(text)
-        os.replace(path + ".tmp", path)
+        os.replace(f"{path}.tmp", path)
 
 
 CONFIG_FILE = "results/campaign_config.yaml"

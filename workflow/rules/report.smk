@@ -1,21 +1,28 @@
-FIGURES = ["fig02_zeta_f", "fig03_zeta_h", "fig04_zeta_fs", "fig05_velocity_profiles",
-           "fig06_zeta_u", "fig07_front_particles", "fig08_shifting_zeta_u",
-           "fig09_shifting_zeta_f", "fig10_shifting_zeta_h", "fig11_cost_vs_error",
-           "fig12_stability_map"]
+# The figures and captions come from one registry, study.figures.FIGURES.
+import os
+
+from study.figures import FIGURES as FIGURE_SPECS
+
+FIGURES = [spec.name for spec in FIGURE_SPECS]
 FMT = config["figures"]["format"]
+CAPTIONS = os.path.abspath("results/report_captions")  # absolute: Snakemake resolves captions from this file's folder
+for spec in FIGURE_SPECS:  # Snakemake's report reads each caption from a file
+    _write_if_changed(f"{CAPTIONS}/{spec.name}.rst", spec.caption_rst(config["figures"]["profile_ch"]))
 
 
 rule figures:
     input:
         "results/campaign.nc",
     output:
-        [report(f"results/figures/{f}.{FMT}", caption=f"../report/{f}.rst", category="Figures")
+        [report(f"results/figures/{f}.{FMT}", caption=f"{CAPTIONS}/{f}.rst", category="Figures")
          for f in FIGURES],
     params:
         settings=lambda wc: yaml.safe_dump(config["figures"]),
         config=CONFIG_FILE,
+    log:
+        "results/logs/figures.log",
     shell:
-        "python -m study figures {params.config} {input} -o results/figures"
+        "python -m study figures {params.config} {input} -o results/figures > {log} 2>&1"
 
 
 rule report_html:
@@ -26,5 +33,7 @@ rule report_html:
         "reports/report.html",
     params:
         config=CONFIG_FILE,
+    log:
+        "results/logs/report_html.log",
     shell:
-        "python -m study report {params.config} {input.campaign} --figures results/figures -o {output}"
+        "python -m study report {params.config} {input.campaign} --figures results/figures -o {output} > {log} 2>&1"

@@ -3,6 +3,8 @@ rule compile_kernels:
         touch("results/.kernels_compiled"),
     log:
         "results/logs/compile_kernels.log",
+    params:
+        solver=SOLVER_HASH,  # the kernels are cached per solver hash: a new solver compiles anew
     shell:
         "python -m solver warm 2> {log}"
 
@@ -10,11 +12,13 @@ rule compile_kernels:
 rule case_file:
     output:
         "results/cases/{case}/case.yaml",
+    log:
+        "results/logs/case_file_{case}.log",
     params:
-        text=case_yaml,
-    run:
-        import pathlib
-        pathlib.Path(output[0]).write_text(params.text)
+        text=case_yaml,  # a change of this case's settings rewrites it (and reruns the case)
+        config=CONFIG_FILE,
+    shell:
+        "python -m study case-file {params.config} {wildcards.case} -o {output} 2> {log}"
 
 
 rule run_case:

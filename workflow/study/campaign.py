@@ -123,7 +123,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["case_status"] = ("case", [r.attrs["status"] for r in runs])
     ds["case_steady"] = ("case", [int(m["steady"]) for m in metrics])
     ds["case_reason"] = ("case", [r.attrs["reason"] for r in runs])
-    for k, (attr, units, long) in RUN_NUMBERS.items():
+    for k, (attr, units, _) in RUN_NUMBERS.items():
         ds[f"case_{k}"] = ("case", [float(r.attrs.get(attr, np.nan)) for r in runs], {"units": units})
     for k in SCALARS:
         ds[f"case_{k}"] = ("case", [float(m[k]) for m in metrics])

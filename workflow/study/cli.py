@@ -30,14 +30,14 @@ def cmd_case_file(a):
     _write_text(a.output, yaml.safe_dump(case_dict(cfg, match[0]), sort_keys=False))
 
 
-def _reference(cfg, run=None):
+def _reference(cfg):
     import numpy as np
+    from .config import solver_case
     from .reference import read_surface_csv, read_velocity_csv, theory
     lo, hi = cfg["metrics"]["free_surface_x_star"]
     x = np.round(np.arange(lo, hi + 1e-9, 0.1), 10)
     z = np.round(np.arange(0.0, 1.3 + 1e-9, 0.025), 10)
-    slope = cfg["case"].get("slope_deg", 15.3)
-    ref = theory(x, cfg["metrics"]["stations"], z, slope)
+    ref = theory(x, cfg["metrics"]["stations"], z, solver_case(cfg).slope_deg)
     m = cfg["reference"]["measured"]
     measured = {"surface": read_surface_csv(m["free_surface"]) if m.get("free_surface") else None,
                 "velocity": {float(k): read_velocity_csv(v) for k, v in (m.get("velocity") or {}).items()}}
@@ -60,7 +60,7 @@ def cmd_reduce(a):
     import xarray as xr
     from solver.output import write_atomic
     from .campaign import build
-    from .config import cases
+    from .config import cases, solver_case
     cfg = _cfg(a.config)
     cs = cases(cfg)
     runs, metrics = [], []
@@ -73,10 +73,15 @@ def cmd_reduce(a):
     import yaml
     ds.attrs.update(h_n_m=float(runs[0].attrs.get("h_n_m", float("nan"))),
                     normalising_depth_m=float(cfg["reference"]["normalising_depth"]),
-                    slope_deg=float(cfg["case"].get("slope_deg", 15.3)),
+                    slope_deg=float(solver_case(cfg).slope_deg),
                     config_yaml=yaml.safe_dump(cfg, sort_keys=False),
                     version_numba=str(runs[0].attrs.get("version_numba", "")))
     write_atomic(ds, a.output)
+
+
+def _figure_settings(cfg, ds):
+    from .figures import Settings
+    return Settings(profile_ch=float(cfg["figures"]["profile_ch"]), slope_deg=float(ds.attrs["slope_deg"]))
 
 
 def cmd_figures(a):
@@ -85,29 +90,27 @@ def cmd_figures(a):
     cfg = _cfg(a.config)
     f = cfg["figures"]
     with xr.open_dataset(a.campaign) as ds:
-        paths = write_all(ds.load(), a.outdir, fmt=f["format"], dpi=f["dpi"],
-                          profile_ch=f["profile_ch"], slope_deg=ds.attrs.get("slope_deg", 15.3))
-    for p in paths:
+        ds = ds.load()
+    for p in write_all(ds, a.outdir, _figure_settings(cfg, ds), fmt=f["format"], dpi=f["dpi"]):
         print(p)
 
 
 def cmd_report(a):
     import xarray as xr
     import yaml
-    from .figures import all_figures
+    from .figures import FIGURES
     from .report import render, write
     cfg = _cfg(a.config)
     f = cfg["figures"]
     with xr.open_dataset(a.campaign) as ds:
         ds = ds.load()
-    import matplotlib.pyplot as plt
+    settings = _figure_settings(cfg, ds)
     figs = []
-    for fig in all_figures(ds, profile_ch=f["profile_ch"], slope_deg=ds.attrs.get("slope_deg", 15.3)):
-        p = Path(a.figures) / f"{fig.name}.{f['format']}"
+    for spec in FIGURES:
+        p = Path(a.figures) / f"{spec.name}.{f['format']}"
         if not p.exists():
             raise SystemExit(f"error: missing figure {p}; run the figures step first")
-        figs.append((p, fig.title, fig.caption))
-        plt.close(fig.fig)
+        figs.append((p, spec.title, spec.full_caption(settings.profile_ch)))
     write(render(ds, figs, yaml.safe_dump(cfg, sort_keys=False)), a.output)
     print(a.output)
 

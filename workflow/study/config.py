@@ -43,9 +43,8 @@ def validate(config: dict) -> dict:
 
     Defaulting = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
     errors = sorted(Defaulting(schema).iter_errors(cfg), key=lambda e: list(e.absolute_path))
-    if errors:
-        e = errors[0]
-        raise ConfigError(f"config key {_path(e)}: {e.message}")
+    if errors:  # every problem at once, each naming its key
+        raise ConfigError("; ".join(f"config key {_path(e)}: {e.message}" for e in errors))
     try:
         cases = expand(cfg["grid"], cfg.get("extra_cases"))
     except ValueError as exc:
@@ -93,6 +92,13 @@ def warm_source(cfg: dict, case: Case) -> Case | None:
 def run_path(case: Case) -> str:
     """Where the campaign writes a case's run (relative to the working directory)."""
     return f"results/cases/{case.id}/run.nc"
+
+
+def solver_case(cfg: dict, case: Case | None = None):
+    """The parsed solver case (solver.conveyor.ConveyorCase) of one campaign case (default:
+    the first); the physical numbers (slope, depth) come from here, not from literals."""
+    from solver.conveyor import case_from_dict
+    return case_from_dict(case_dict(cfg, case if case is not None else cases(cfg)[0]))
 
 
 def case_dict(cfg: dict, case: Case) -> dict:

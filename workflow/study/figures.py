@@ -1,8 +1,10 @@
-"""The paper's Figs. 2-10 from the campaign dataset alone (matplotlib, colour-blind safe)."""
+"""The report's figures, the paper's Figs. 2-10 and then ours, from the campaign dataset alone
+(matplotlib, colour-blind safe), and their registry ``FIGURES``."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import matplotlib
 
@@ -20,12 +22,29 @@ STYLE = {"figure.dpi": 100, "axes.grid": True, "grid.alpha": 0.3, "font.size": 1
          "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False}
 
 
-@dataclass
-class Figure:
+@dataclass(frozen=True)
+class Settings:
+    """What a figure takes beyond the campaign dataset."""
+    profile_ch: float  # Ch of the single-Ch figures (nearest in the grid)
+    slope_deg: float  # the case's slope, for the theory curves
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """One figure of the report: its file name, title, caption and drawing function.
+    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note."""
     name: str
     title: str
     caption: str
-    fig: object
+    draw: Callable[[xr.Dataset, Settings], object]
+    hollow: bool = False
+
+    def full_caption(self, profile_ch: float) -> str:
+        return self.caption.format(ch=profile_ch) + (HOLLOW if self.hollow else "")
+
+    def caption_rst(self, profile_ch: float) -> str:
+        """The caption as reStructuredText, for Snakemake's report."""
+        return f"**{self.title}.** {self.full_caption(profile_ch)}\n"
 
 
 def _dp_mm(ds):
@@ -79,7 +98,7 @@ def _error_vs_dp(ax, ds, var, shifting, label_ch=True, station=None):
     _log_axes(ax, drawn)
 
 
-def _metric_figure(ds, var, ylabel, name, title, caption):
+def _metric_figure(ds, var, ylabel):
     shs = list(ds["shifting"].values)
     fig, axs = plt.subplots(1, len(shs), figsize=(4.6 * len(shs), 3.6), squeeze=False, sharey=True)
     for ax, sh in zip(axs[0], shs):
@@ -88,7 +107,7 @@ def _metric_figure(ds, var, ylabel, name, title, caption):
     axs[0][0].set_ylabel(ylabel)
     _legend(axs[0], fontsize=8)
     fig.tight_layout()
-    return Figure(name, title, caption + HOLLOW, fig)
+    return fig
 
 
 HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over the final window "
@@ -115,11 +134,7 @@ def fig_velocity_profiles(ds, ch, slope_deg):
                 ax.set_ylabel("z* = z / h_n")
     axs[0][-1].legend(fontsize=8)
     fig.tight_layout()
-    return Figure("fig05_velocity_profiles", "Fig. 5 - velocity profiles",
-                  f"Steady velocity profiles u*(z*) in the belt frame at the three stations for "
-                  f"Ch = {ch:g} and every dp, against lubrication theory (black). The paper "
-                  "found the profiles well reproduced away from the toe, with the largest "
-                  "deviations at x* = 0.76 where the theory itself is approximate.", fig)
+    return fig
 
 
 def fig_front_particles(ds, ch):
@@ -138,14 +153,10 @@ def fig_front_particles(ds, ch):
         ax.invert_xaxis()
     axs[-1, 0].set_xlabel("x* upslope from the toe")
     fig.tight_layout()
-    return Figure("fig07_front_particles", "Fig. 7 - particles at the front",
-                  "Final fluid particle distribution within 3 h_n of the toe for each shifting "
-                  "method at the finest dp and Ch = 1.8. The paper found the Lind shifting "
-                  "smoother and less ordered near the free surface than the Skillen (DualSPHysics "
-                  "release) shifting.", fig)
+    return fig
 
 
-def fig_shifting_comparison(ds, var, ch, name, title, ylabel, caption, station_panels=False):
+def fig_shifting_comparison(ds, var, ch, station_panels=False):
     ch = float(ds["ch"].sel(ch=ch, method="nearest"))
     sub = ds.sel(ch=ch)
     panels = list(ds["station"].values) if station_panels else [None]
@@ -158,12 +169,12 @@ def fig_shifting_comparison(ds, var, ch, name, title, ylabel, caption, station_p
                 y = y.sel(station=s)
             drawn |= _points(ax, _dp_mm(sub), y.values, sub["steady"].sel(shifting=sh).values, k, sh)
         _log_axes(ax, drawn)
-        ax.set_ylabel(ylabel)
+        ax.set_ylabel(var)
         if s is not None:
             ax.set_title(f"x* = {s:g}")
     axs[0][-1].legend()
     fig.tight_layout()
-    return Figure(name, title, caption + HOLLOW, fig)
+    return fig
 
 
 COST_METRICS = (("zeta_f", None), ("zeta_h", None), ("zeta_fs", None), ("zeta_u", 9.7))
@@ -202,11 +213,7 @@ def fig_cost_vs_error(ds):
         ax.set_ylabel(var if st is None else f"{var} (x* = {st:g})")
     axs[0][0].legend(fontsize=8)
     fig.tight_layout()
-    return Figure("fig11_cost_vs_error", "Run time against error",
-                  "Wall time of each case against each error metric (log-log), with the Pareto "
-                  "front (no case is both cheaper and more accurate) labelled by dp, Ch and "
-                  "shifting (steady and not-steady runs alike; the Cost table counts steady runs only). "
-                  "Not in the paper: it answers which run is the cheapest one to trust.", fig)
+    return fig
 
 
 def fig_stability_map(ds):
@@ -216,7 +223,10 @@ def fig_stability_map(ds):
     from .stability import MARGINS
     cases = [str(c) for c in ds["case"].values]
     n = len(cases)
-    vals = np.stack([ds[f"case_{k}"].values for k in MARGINS], axis=1) if "case_density_margin" in ds else np.full((n, 3), np.nan)
+    if "case_density_margin" in ds:
+        vals = np.stack([ds[f"case_{k}"].values for k in MARGINS], axis=1)
+    else:
+        vals = np.full((n, 3), np.nan)
     fig, ax = plt.subplots(figsize=(9.5, 0.9 + 0.28 * n))
     cmap = ListedColormap(["#009E73", "#F0E442", "#E69F00", "#D55E00"])  # <0.25, <0.5, <1, >=1
     level = np.digitize(np.nan_to_num(vals, nan=-1.0), [0.25, 0.5, 1.0]).astype(float)
@@ -242,73 +252,101 @@ def fig_stability_map(ds):
     for sp in ax.spines.values():
         sp.set_visible(False)
     fig.tight_layout()
-    return Figure("fig12_stability_map", "Stability map",
-                  "Each case (row): the largest value reached by each guarded quantity as a "
-                  "fraction of its guard (green < 0.25, yellow < 0.5, orange < 1, vermillion: the "
-                  "guard fired), the peak kinetic energy in units of 0.5 M u_b^2 (about 1 for "
-                  "the belt flow), and the outcome: the detector that stopped a diverged run and "
-                  "when. Not in the paper: it shows where explicit SPH breaks on this flow and "
-                  "how close the survivors came.", fig)
+    return fig
 
 
-def all_figures(ds: xr.Dataset, profile_ch: float = 1.8, slope_deg: float = 15.3) -> list[Figure]:
-    with plt.rc_context(STYLE):
-        figs = [
-            _metric_figure(ds, "zeta_f", "zeta_f", "fig02_zeta_f", "Fig. 2 - front velocity error",
-                           "Front velocity error zeta_f = |u*_f - u*_b| / u*_b against dp for each Ch "
-                           "(one panel per shifting method). The paper found zeta_f below a few per cent, decreasing with dp, "
-                           "with the smallest Ch the least accurate."),
-            _metric_figure(ds, "zeta_h", "zeta_h", "fig03_zeta_h", "Fig. 3 - uniform depth error",
-                           "Uniform-zone depth error zeta_h (against the computed h_n) against dp for "
-                           "each Ch. The paper reported depth errors of a few per cent against its "
-                           "normalising depth; the campaign table gives both."),
-            _metric_figure(ds, "zeta_fs", "zeta_fs", "fig04_zeta_fs", "Fig. 4 - free-surface error",
-                           "RMS free-surface error zeta_fs (normalised depths) against dp for each Ch, "
-                           "against lubrication theory. The paper found it small and converging."),
-            fig_velocity_profiles(ds, profile_ch, slope_deg),
-        ]
-        st = ds["station"].values
-        shs = list(ds["shifting"].values)
-        fig, axs = plt.subplots(len(shs), st.size, figsize=(3.6 * st.size, 3.2 * len(shs)),
-                                squeeze=False, sharey=True)
-        for i, sh in enumerate(shs):
-            for j, s in enumerate(st):
-                _error_vs_dp(axs[i][j], ds, "zeta_u", sh, station=s)
-                axs[i][j].set_title(f"x* = {s:g}, {sh}")
-            axs[i][0].set_ylabel("zeta_u")
-        _legend(axs.ravel(), fontsize=8)
-        fig.tight_layout()
-        figs.append(Figure("fig06_zeta_u", "Fig. 6 - velocity-profile errors",
-                           "RMS velocity-profile error zeta_u,j at each station against dp for each "
-                           "Ch. The paper found the errors largest near the toe (x* = 0.76) and "
-                           "smallest in the uniform zone (x* = 9.7)." + HOLLOW, fig))
-        figs.append(fig_front_particles(ds, profile_ch))
-        figs.append(fig_shifting_comparison(
-            ds, "zeta_u", profile_ch, "fig08_shifting_zeta_u", "Fig. 8 - shifting: velocity errors",
-            "zeta_u", "zeta_u,j for the two shifting methods at Ch = 1.8. The paper found the "
-            "shifting method marginally affects the velocity-profile error.", station_panels=True))
-        figs.append(fig_shifting_comparison(
-            ds, "zeta_f", profile_ch, "fig09_shifting_zeta_f", "Fig. 9 - shifting: front velocity",
-            "zeta_f", "zeta_f for the two shifting methods at Ch = 1.8. The paper found the Lind "
-            "shifting better for the front velocity."))
-        figs.append(fig_cost_vs_error(ds))
-        figs.append(fig_stability_map(ds))
-        figs.append(fig_shifting_comparison(
-            ds, "zeta_h", profile_ch, "fig10_shifting_zeta_h", "Fig. 10 - shifting: uniform depth",
-            "zeta_h", "zeta_h for the two shifting methods at Ch = 1.8. The paper found the Lind "
-            "shifting better for the uniform depth."))
-    return figs
+def fig_zeta_u(ds):
+    st = ds["station"].values
+    shs = list(ds["shifting"].values)
+    fig, axs = plt.subplots(len(shs), st.size, figsize=(3.6 * st.size, 3.2 * len(shs)),
+                            squeeze=False, sharey=True)
+    for i, sh in enumerate(shs):
+        for j, s in enumerate(st):
+            _error_vs_dp(axs[i][j], ds, "zeta_u", sh, station=s)
+            axs[i][j].set_title(f"x* = {s:g}, {sh}")
+        axs[i][0].set_ylabel("zeta_u")
+    _legend(axs.ravel(), fontsize=8)
+    fig.tight_layout()
+    return fig
 
 
-def write_all(ds: xr.Dataset, outdir, fmt: str = "png", dpi: int = 120, **kw) -> list[Path]:
+# The report's figures, in the paper's order and then ours: the rules, the captions of
+# Snakemake's report and the HTML report all read this list.
+FIGURES = (
+    FigureSpec("fig02_zeta_f", "Fig. 2 - front velocity error",
+               "Front velocity error zeta_f = |u*_f - u*_b| / u*_b against dp for each Ch (one "
+               "panel per shifting method). The paper found zeta_f below a few per cent, "
+               "decreasing with dp, with the smallest Ch the least accurate.",
+               lambda ds, st: _metric_figure(ds, "zeta_f", "zeta_f"), hollow=True),
+    FigureSpec("fig03_zeta_h", "Fig. 3 - uniform depth error",
+               "Uniform-zone depth error zeta_h (against the computed h_n) against dp for each "
+               "Ch. The paper reported depth errors of a few per cent against its normalising "
+               "depth; the campaign table gives both.",
+               lambda ds, st: _metric_figure(ds, "zeta_h", "zeta_h"), hollow=True),
+    FigureSpec("fig04_zeta_fs", "Fig. 4 - free-surface error",
+               "RMS free-surface error zeta_fs (normalised depths) against dp for each Ch, against "
+               "lubrication theory. The paper found it small and converging.",
+               lambda ds, st: _metric_figure(ds, "zeta_fs", "zeta_fs"), hollow=True),
+    FigureSpec("fig05_velocity_profiles", "Fig. 5 - velocity profiles",
+               "Steady velocity profiles u*(z*) in the belt frame at the three stations for "
+               "Ch = {ch:g} (or the grid's nearest) and every dp, against lubrication theory "
+               "(black). The paper found the profiles well reproduced away from the toe, with "
+               "the largest deviations at x* = 0.76 where the theory itself is approximate.",
+               lambda ds, st: fig_velocity_profiles(ds, st.profile_ch, st.slope_deg)),
+    FigureSpec("fig06_zeta_u", "Fig. 6 - velocity-profile errors",
+               "RMS velocity-profile error zeta_u,j at each station against dp for each Ch. The "
+               "paper found the errors largest near the toe (x* = 0.76) and smallest in the "
+               "uniform zone (x* = 9.7).",
+               lambda ds, st: fig_zeta_u(ds), hollow=True),
+    FigureSpec("fig07_front_particles", "Fig. 7 - particles at the front",
+               "Final fluid particle distribution within 3 h_n of the toe for each shifting "
+               "method at the finest dp and Ch = {ch:g} (or the grid's nearest). The paper found "
+               "the Lind shifting smoother and less ordered near the free surface than the "
+               "Skillen (DualSPHysics release) shifting.",
+               lambda ds, st: fig_front_particles(ds, st.profile_ch)),
+    FigureSpec("fig08_shifting_zeta_u", "Fig. 8 - shifting: velocity errors",
+               "zeta_u,j for the two shifting methods at Ch = {ch:g}. The paper found the "
+               "shifting method marginally affects the velocity-profile error.",
+               lambda ds, st: fig_shifting_comparison(ds, "zeta_u", st.profile_ch, station_panels=True),
+               hollow=True),
+    FigureSpec("fig09_shifting_zeta_f", "Fig. 9 - shifting: front velocity",
+               "zeta_f for the two shifting methods at Ch = {ch:g}. The paper found the Lind "
+               "shifting better for the front velocity.",
+               lambda ds, st: fig_shifting_comparison(ds, "zeta_f", st.profile_ch), hollow=True),
+    FigureSpec("fig10_shifting_zeta_h", "Fig. 10 - shifting: uniform depth",
+               "zeta_h for the two shifting methods at Ch = {ch:g}. The paper found the Lind "
+               "shifting better for the uniform depth.",
+               lambda ds, st: fig_shifting_comparison(ds, "zeta_h", st.profile_ch), hollow=True),
+    FigureSpec("fig11_cost_vs_error", "Run time against error",
+               "Wall time of each case against each error metric (log-log), with the Pareto "
+               "front (no case is both cheaper and more accurate) labelled by dp, Ch and "
+               "shifting (steady and not-steady runs alike; the Cost table counts steady runs "
+               "only). Not in the paper: it answers which run is the cheapest one to trust.",
+               lambda ds, st: fig_cost_vs_error(ds)),
+    FigureSpec("fig12_stability_map", "Stability map",
+               "Each case (row): the largest value reached by each guarded quantity as a "
+               "fraction of its guard (green < 0.25, yellow < 0.5, orange < 1, vermillion: the "
+               "guard fired), the peak kinetic energy in units of 0.5 M u_b^2 (about 1 for the "
+               "belt flow), and the outcome: the detector that stopped a diverged run and when. "
+               "Not in the paper: it shows where explicit SPH breaks on this flow and how close "
+               "the survivors came.",
+               lambda ds, st: fig_stability_map(ds)),
+)
+FIGURE_NAMES = tuple(f.name for f in FIGURES)
+
+
+def write_all(ds: xr.Dataset, outdir, settings: Settings, fmt: str = "png", dpi: int = 120) -> list[Path]:
+    """Draw every registered figure into outdir/<name>.<fmt> (each written atomically)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     paths = []
-    for f in all_figures(ds, **kw):
-        p = outdir / f"{f.name}.{fmt}"
+    for spec in FIGURES:
+        with plt.rc_context(STYLE):
+            fig = spec.draw(ds, settings)
+        p = outdir / f"{spec.name}.{fmt}"
         tmp = p.with_suffix(p.suffix + ".tmp")
-        f.fig.savefig(tmp, dpi=dpi, format=fmt)
-        plt.close(f.fig)
+        fig.savefig(tmp, dpi=dpi, format=fmt)
+        plt.close(fig)
         tmp.replace(p)
         paths.append(p)
     return paths

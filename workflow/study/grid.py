@@ -1,11 +1,9 @@
 """Case grid: dp x Ch x shifting from the config, with canonical, float-safe case ids."""
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 
 CASE_ID = r"dp[0-9]+(?:\.[0-9]+)?mm_ch[0-9]+(?:\.[0-9]+)?_(?:none|skillen|lind)(?:_[a-z0-9-]+)?"
-_NUM = re.compile(r"^-?[0-9]+(\.[0-9]+)?$")
 
 
 def fmt(x: float, digits: int = 6) -> str:

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-SECTIONS = ("Summary", "Configuration", "Cases", "Convergence", "Cost", "Figures", "Provenance")
 CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;
+padding:0 1em;color:#222}
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
 table{border-collapse:collapse;font-size:.85em}td,th{border:1px solid #ddd;padding:3px 6px;text-align:right}
 th{background:#f3f3f3}td.l,th.l{text-align:left}tr.diverged td{background:#fde2e1}tr.not_steady td{background:#fff4d6}
@@ -138,7 +138,8 @@ def stability_section(ds: xr.Dataset) -> str:
         text += ("<table><tr><th class='l'>setting</th><th class='l'>value</th><th>tried</th>"
                  "<th>survived</th><th>safe</th><th class='l'>detectors that fired</th>"
                  "<th class='l'>others at base: outcome (worst margin)</th></tr>"
-                 + "".join(f"<tr><td class='l'>{html.escape(r['setting'])}</td><td class='l'>{html.escape(r['value'])}</td>"
+                 + "".join(f"<tr><td class='l'>{html.escape(r['setting'])}</td>"
+                           f"<td class='l'>{html.escape(r['value'])}</td>"
                            f"<td>{r['tried']}</td><td>{r['survived']}</td><td>{r['safe']}</td>"
                            f"<td class='l'>{html.escape(', '.join(r['detectors']))}</td>"
                            f"<td class='l'>{html.escape(alone(r))}</td></tr>" for r in rows)
@@ -190,7 +191,8 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
             "sph-surge": solver.__version__, "numpy": np.__version__, "xarray": xr.__version__,
             "matplotlib": matplotlib.__version__, "snakemake": snakemake.__version__,
             "numba": ds.attrs.get("version_numba", ""), "cwd": os.getcwd()}
-    prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th><td class="l">{html.escape(str(v))}</td></tr>'
+    prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th>'
+                                    f'<td class="l">{html.escape(str(v))}</td></tr>'
                                     for k, v in prov.items()) + "</table>"
     body = [("Summary", summary), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
             ("Cases", case_table(ds)), ("Convergence", convergence_table(ds)),

@@ -62,7 +62,9 @@ def margins(run: xr.Dataset) -> dict[str, float]:
            "area_drift_margin": peak("area_drift") / float(case.get("max_area_drift", 0.05))}
     ke = peak("kinetic_energy")
     ub = float(run.attrs.get("belt_speed_m_s", nan))
-    mass = float(run["mass_area"].values[0]) * float(run.attrs.get("rho0", nan)) if "mass_area" in run and run.sizes.get("time", 0) else nan
+    mass = nan
+    if "mass_area" in run and run.sizes.get("time", 0):
+        mass = float(run["mass_area"].values[0]) * float(run.attrs.get("rho0", nan))
     fired = {"density deviation": "density_margin", "wall crossing": "penetration_margin",
              "area drift": "area_drift_margin"}.get(detector(run.attrs.get("status", ""), run.attrs.get("reason", "")))
     if fired:
