@@ -27,6 +27,9 @@ import numpy as np
 import xarray as xr
 import yaml
 
+from solver.conveyor import case_from_dict
+from solver.kernel import grad_coefficient
+
 
 def operator_response(x, z, kind, rho, mass, h, nu, g_s, depth, bands):
     """Mean and spread of a_a / (-g_s) over each band of particle indices."""
@@ -34,7 +37,7 @@ def operator_response(x, z, kind, rho, mass, h, nu, g_s, depth, bands):
         return np.where(zz >= 0, g_s / nu * (depth * zz - zz * zz / 2), g_s / nu * (depth * zz + zz * zz / 2))
 
     u = film(z)
-    fac = -5.0 * 7.0 / (4.0 * math.pi * h * h) / (h * h)
+    fac = grad_coefficient(h)
     eta2 = 0.01 * h * h
     out = {}
     for name, idx in bands.items():
@@ -51,7 +54,7 @@ def operator_response(x, z, kind, rho, mass, h, nu, g_s, depth, bands):
 
 
 def moments(x, z, volume, h, idx, depth):
-    fac = -5.0 * 7.0 / (4.0 * math.pi * h * h) / (h * h)
+    fac = grad_coefficient(h)
     gz, mzz = [], []
     for a in idx:
         d2 = (x - x[a]) ** 2 + (z - z[a]) ** 2
@@ -69,9 +72,9 @@ def report(path):
     ds = xr.open_dataset(path)
     hn, dp, h = ds.attrs["h_n_m"], float(ds.attrs["dp"]), float(ds.attrs["h"])
     rho0 = float(ds.attrs["rho0"])
-    case = yaml.safe_load(ds.attrs["case_yaml"])
-    nu = case.get("viscosity", 5.6) / case.get("density", rho0)
-    g_s = case.get("gravity", 9.81) * math.sin(math.radians(case.get("slope_deg", 15.3)))
+    case = case_from_dict(yaml.safe_load(ds.attrs["case_yaml"]))
+    nu = case.viscosity / case.density
+    g_s = case.gravity * math.sin(case.theta)
     s = ds.isel(snapshot=-1)
     ok = np.isfinite(s.x.values)
     x, z, kind, rho = s.x.values[ok], s.z.values[ok], s.kind.values[ok], s.rho.values[ok]

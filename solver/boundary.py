@@ -19,9 +19,9 @@ import math
 import numba as nb
 import numpy as np
 
-from .cells import neighbour_cell
+from .cells import cell_of, neighbour_cell
 from .forces import FASTMATH
-from .kernel import grad_factor, w_value
+from .kernel import alpha_2d, grad_coefficient, grad_factor, w_value
 
 DET_MIN = 1.0e-3  # on the matrix made dimensionless with h
 
@@ -63,15 +63,15 @@ def make_mdbc_update(corrected_velocity: bool):
     """Compile the mDBC update with the Shepard or the corrected ghost velocity."""
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-    def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, start, n_active,
-                    x0, z0, csx, csz, ncx, ncz, periodic, period, h, rho0):
+    def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, h, rho0):
         """Set density and no-slip velocity of every active boundary particle from its ghost.
 
         v_g is Shepard-interpolated (SPEC), or first-order corrected like the density when
         ``corrected_velocity`` (and the matrix is well conditioned).
         """
-        alpha = 7.0 / (4.0 * math.pi * h * h)
-        fac = -5.0 * alpha / (h * h)
+        alpha = alpha_2d(h)
+        fac = grad_coefficient(h)
+        periodic, period, x0 = cl.periodic, cl.period, cl.x0
         four_h2 = 4.0 * h * h
         for i in nb.prange(n_active):
             if kind[i] != 1:
@@ -85,18 +85,17 @@ def make_mdbc_update(corrected_velocity: bool):
                 continue
             if periodic:
                 gx = x0 + (gx - x0) % period
-            ix = int(math.floor((gx - x0) / csx))
-            iz = int(math.floor((gz - z0) / csz))
+            ix, iz = cell_of(cl, gx, gz)
             a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
             b0 = b1 = b2 = 0.0
             su = sw = 0.0
             bu1 = bu2 = bw1 = bw2 = 0.0
             for ddx in range(-1, 2):
                 for ddz in range(-1, 2):
-                    c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                    c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
                     if c < 0:
                         continue
-                    for j in range(start[c], start[c + 1]):
+                    for j in range(cl.start[c], cl.start[c + 1]):
                         if kind[j] != 0:
                             continue
                         dx = gx - (x[j] + shift)  # r_gj

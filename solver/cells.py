@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -36,37 +37,63 @@ class Grid:
             raise ValueError("periodic grid needs at least 3 cells across the period")
         return cls(x0, z0, csx, reach, max(ncx, 1), ncz, periodic, (x1 - x0) if periodic else 0.0)
 
+    def cell_list(self, start: np.ndarray) -> CellList:
+        """The grid with its sorted particle ranges, as the kernels take it."""
+        return CellList(start, float(self.x0), float(self.z0), float(self.csx), float(self.csz),
+                        int(self.ncx), int(self.ncz), bool(self.periodic), float(self.period))
+
+
+class CellList(NamedTuple):
+    """What a kernel needs to walk neighbours: cell c = ix * ncz + iz holds the particles
+    start[c] .. start[c + 1] - 1; cells of csx x csz from (x0, z0); periodic in x with
+    ``period`` when ``periodic``."""
+    start: np.ndarray
+    x0: float
+    z0: float
+    csx: float
+    csz: float
+    ncx: int
+    ncz: int
+    periodic: bool
+    period: float
+
 
 @nb.njit(inline="always", cache=True)
-def neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period):
+def cell_of(cl, px, pz):
+    """(ix, iz) of the cell holding point (px, pz) (possibly outside the grid)."""
+    return int(math.floor((px - cl.x0) / cl.csx)), int(math.floor((pz - cl.z0) / cl.csz))
+
+
+@nb.njit(inline="always", cache=True)
+def neighbour_cell(cl, ix, iz, ddx, ddz):
     """(cell id, x shift to add to its particles) of cell (ix + ddx, iz + ddz), wrapping in x
     when periodic; cell -1 when outside the grid."""
     jx = ix + ddx
     jz = iz + ddz
     shift = 0.0
-    if jz < 0 or jz >= ncz:
+    if jz < 0 or jz >= cl.ncz:
         return -1, shift
-    if jx < 0 or jx >= ncx:
-        if not periodic:
+    if jx < 0 or jx >= cl.ncx:
+        if not cl.periodic:
             return -1, shift
-        shift = -period if jx < 0 else period
-        jx = jx + ncx if jx < 0 else jx - ncx
-    return jx * ncz + jz, shift
+        shift = -cl.period if jx < 0 else cl.period
+        jx = jx + cl.ncx if jx < 0 else jx - cl.ncx
+    return jx * cl.ncz + jz, shift
 
 
 @nb.njit(cache=True)
-def assign_cells(x, z, kind, x0, z0, csx, csz, ncx, ncz, cell):
+def assign_cells(x, z, kind, cl, cell):
     """Write each particle's cell (sentinel ncx*ncz for idle boundary particles).
 
     Returns the index of a fluid particle outside the grid, or -1.
     """
     n = x.size
+    ncx, ncz = cl.ncx, cl.ncz
     ncells = ncx * ncz
     has_fluid = np.zeros(ncells, dtype=np.bool_)
     bad = -1
     for i in range(n):
-        ix = int(math.floor((x[i] - x0) / csx))
-        iz = int(math.floor((z[i] - z0) / csz))
+        ix, iz = cell_of(cl, x[i], z[i])
         if ix < 0 or ix >= ncx or iz < 0 or iz >= ncz or not (math.isfinite(x[i]) and math.isfinite(z[i])):
             cell[i] = ncells
             if kind[i] == 0 and bad < 0:
@@ -122,8 +149,9 @@ def gather(src, order, dst):
 
 
 @nb.njit(cache=True)
-def column_split(start, ncx, ncz, nthreads, split):
+def column_split(cl, nthreads, split):
     """Columns [split[t], split[t+1]) for thread t, balancing particle counts."""
+    start, ncx, ncz = cl.start, cl.ncx, cl.ncz
     total = start[ncx * ncz]
     split[0] = 0
     t = 1

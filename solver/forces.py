@@ -33,11 +33,12 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
 
-from .kernel import grad_factor
+from .kernel import grad_coefficient, grad_factor
 
 # Accumulator slots of the pair loop, acc[thread, particle, slot]
 AX, AZ, DRHO = 0, 1, 2                # acceleration, drho/dt
@@ -86,6 +87,85 @@ def thread_rows(start, split, t, ncx, ncz):
     return start[split[t] * ncz], start[min(split[t + 1] + 1, ncx) * ncz]
 
 
+class PairFields(NamedTuple):
+    """Particle arrays the pair loop reads, in cell order. sdx, sdz: the last shift (read
+    only with the shifting density correction); wnx, wnz: inward wall normals."""
+    x: np.ndarray
+    z: np.ndarray
+    u: np.ndarray
+    w: np.ndarray
+    rho: np.ndarray
+    p: np.ndarray
+    mass: np.ndarray
+    kind: np.ndarray
+    wnx: np.ndarray
+    wnz: np.ndarray
+    sdx: np.ndarray
+    sdz: np.ndarray
+
+
+class PairConstants(NamedTuple):
+    """Scene constants of the pair loop: hc0 = h c0; k_hyd = rho0 g_z / B and
+    k_col = rho0 g_z / c0^2 (g_z < 0) for the two diffusion references; dp2 = dp^2."""
+    h: float
+    nu: float
+    hc0: float
+    rho0: float
+    k_hyd: float
+    k_col: float
+    delta: float
+    dp2: float
+
+
+# ---- the SPEC terms of one pair (a, b), gradW_ab = F r_ab, each inlined into the loop ----
+
+@nb.njit(inline="always", cache=True)
+def pressure_factor(pa, pb, ira, irb, F, fluid_wall):
+    """pt = (P_a + P_b) / (rho_a rho_b) F, so that du_a/dt gets -m_b pt r_ab; for a
+    fluid-wall pair P_a + P_b is floored at 0 (a wall pushes, never pulls)."""
+    psum = pa + pb
+    if fluid_wall and psum < 0.0:
+        psum = 0.0
+    return psum * (ira * irb) * F
+
+
+@nb.njit(inline="always", cache=True)
+def laminar_factor(nu, rdotg, ra, rb, inv_r2e):
+    """vt = 4 nu (r_ab . gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)), so that du_a/dt gets
+    m_b vt u_ab (Lo & Shao)."""
+    return 4.0 * nu * rdotg / (ra + rb) * inv_r2e
+
+
+@nb.njit(inline="always", cache=True)
+def diffusion_weight(delta, hc0, rdotg, inv_r2e):
+    """g = 2 delta h c0 (r_ab . gradW_ab) / (r^2 + eta^2), the weight of D_a's pair term."""
+    return 2.0 * delta * hc0 * rdotg * inv_r2e
+
+
+@nb.njit(inline="always", cache=True)
+def diffusion_spec(g, drab, dz, rho0, k_hyd):
+    """(a's, b's) terms g ((rho_a - rho_b) - rho^H_ab), per V_b and V_a, with SPEC's
+    rho^H_ab = rho0 ((1 + k_hyd (z_a - z_b))^(1/7) - 1), k_hyd = rho0 g_z / B."""
+    fa, fb = hydrostatic_pair(k_hyd * dz)
+    return g * (drab - rho0 * fa), g * (-drab - rho0 * fb)
+
+
+@nb.njit(inline="always", cache=True)
+def diffusion_column(g, drab, dz, ra, rb, rho0, k_col):
+    """g ((rho_a - rho_b) - rho^H_ab) with the Tait column's
+    rho^H_ab = k_col (z_a - z_b) (rho0 / rho_m)^5, rho_m = (rho_a + rho_b) / 2; b gets its negative."""
+    rm = 2.0 * rho0 / (ra + rb)
+    rm2 = rm * rm
+    return g * (drab - k_col * dz * rm2 * rm2 * rm)
+
+
+@nb.njit(inline="always", cache=True)
+def concentration_terms(dp2, F, dx, dz, rdotg):
+    """a's shares of gradC = sum_b dp^2 gradW_ab and div r = -sum_b dp^2 r_ab . gradW_ab
+    (b gets -gradC's and the same div r share)."""
+    return dp2 * F * dx, dp2 * F * dz, -dp2 * rdotg
+
+
 @functools.cache
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
                    column_reference: bool = False, viscous_correction: bool = False):
@@ -95,10 +175,14 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     of ``correct_viscous_term``."""
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-    def pair_loop(x, z, u, w, rho, p, mass, kind, wnx, wnz, sdx, sdz, start, ncx, ncz, periodic,
-                  period, split, h, nu, hc0, rho0, k_hyd, k_col, delta, dp2, acc, vmax):
+    def pair_loop(f, cl, split, k, acc, vmax):
+        """acc[t, i, :] += the pair sums of the particles thread t writes (``PairFields`` f,
+        ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2)."""
+        x, z, u, w, rho, p, mass, kind = f.x, f.z, f.u, f.w, f.rho, f.p, f.mass, f.kind
+        start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
+        h, nu, hc0, rho0, dp2 = k.h, k.nu, k.hc0, k.rho0, k.dp2
         nt = split.size - 1
-        fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
+        fac = grad_coefficient(h)
         eta2 = 0.01 * h * h
         four_h2 = 4.0 * h * h
         inv_h = 1.0 / h
@@ -115,10 +199,10 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                     a0, a1 = start[ca], start[ca + 1]
                     if a0 == a1:
                         continue
-                    for k in range(5):
+                    for s_k in range(5):
                         # half stencil: self, (0,+1), (+1,-1), (+1,0), (+1,+1)
-                        jx = ix if k < 2 else ix + 1
-                        jz = iz + 1 if k == 1 else (iz if k < 2 else iz + k - 3)
+                        jx = ix if s_k < 2 else ix + 1
+                        jz = iz + 1 if s_k == 1 else (iz if s_k < 2 else iz + s_k - 3)
                         shift = 0.0
                         if jx == ncx:
                             if not periodic:
@@ -141,8 +225,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
                             sxa = sza = 0.0
                             if shift_correction:
-                                sxa, sza = sdx[a], sdz[a]
-                            first = a + 1 if k == 0 else b0
+                                sxa, sza = f.sdx[a], f.sdz[a]
+                            first = a + 1 if s_k == 0 else b0
                             for b in range(first, b1):
                                 kb = kind[b]
                                 if ka + kb == 2:
@@ -162,16 +246,13 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 irb = 1.0 / rb
                                 Vb = mb * irb
                                 inv_r2e = 1.0 / (r2 + eta2)
-                                # continuity
+                                # continuity: rho_a u_ab . gradW_ab V_b
                                 udotg = F * vdotr
                                 s_drho += ra * udotg * Vb
                                 drho_b = rb * udotg * Va
-                                # pressure and laminar viscosity
-                                psum = pa + p[b]
-                                if ka + kb == 1 and psum < 0.0:
-                                    psum = 0.0  # a wall pushes, never pulls
-                                pt = psum * (ira * irb) * F
-                                vt = 4.0 * nu * rdotg / (ra + rb) * inv_r2e
+                                # momentum: pressure and laminar viscosity
+                                pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
+                                vt = laminar_factor(nu, rdotg, ra, rb, inv_r2e)
                                 fx = -pt * dx + vt * du
                                 fz = -pt * dz + vt * dw
                                 s_ax += mb * fx
@@ -182,36 +263,31 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 if vr > vm:
                                     vm = vr
                                 if diffusion:
-                                    if ka + kb == 0:
-                                        g = 2.0 * delta * hc0 * rdotg * inv_r2e
-                                        drab = ra - rb
+                                    if ka + kb == 0:  # fluid pairs only
+                                        g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
                                         if column_reference:
-                                            rm = 2.0 * rho0 / (ra + rb)
-                                            rm2 = rm * rm
-                                            e = drab - k_col * dz * rm2 * rm2 * rm
-                                            s_drho += g * e * Vb
-                                            drho_b -= g * e * Va
+                                            ge = diffusion_column(g, ra - rb, dz, ra, rb, rho0, k.k_col)
+                                            s_drho += ge * Vb
+                                            drho_b -= ge * Va
                                         else:
-                                            fa, fb = hydrostatic_pair(k_hyd * dz)
-                                            s_drho += g * (drab - rho0 * fa) * Vb
-                                            drho_b += g * (-drab - rho0 * fb) * Va
+                                            ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
+                                            s_drho += ea * Vb
+                                            drho_b += eb * Va
                                 at[b, DRHO] += drho_b
                                 if shifting:
-                                    # concentration counts particles: volume dp^2 each
-                                    sx = dp2 * F * dx
-                                    sz = dp2 * F * dz
+                                    sx, sz, sdiv = concentration_terms(dp2, F, dx, dz, rdotg)
                                     s_gcx += sx
                                     s_gcz += sz
                                     at[b, GCX] -= sx
                                     at[b, GCZ] -= sz
-                                    s_divr -= dp2 * rdotg
-                                    at[b, DIVR] -= dp2 * rdotg
+                                    s_divr += sdiv
+                                    at[b, DIVR] += sdiv
                                     if kb == 1:
-                                        s_wnx -= F * wnx[b]
-                                        s_wnz -= F * wnz[b]
+                                        s_wnx -= F * f.wnx[b]
+                                        s_wnz -= F * f.wnz[b]
                                     elif ka == 1:
-                                        at[b, WNX] -= F * wnx[a]
-                                        at[b, WNZ] -= F * wnz[a]
+                                        at[b, WNX] -= F * f.wnx[a]
+                                        at[b, WNZ] -= F * f.wnz[a]
                                 if viscous_correction:
                                     # gradW_ab = F r_ab; gradW_ba = -gradW_ab
                                     s_vgx += Vb * F * dx
@@ -231,7 +307,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     at[b, VDIVR] -= Va * rdotg
                                 if shift_correction:
                                     # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
-                                    e = F * ((sdx[b] - sxa) * dx + (sdz[b] - sza) * dz)
+                                    e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
                                     s_divdr += Vb * e
                                     at[b, DIVDR] += Va * e
                             at[a, AX] += s_ax
@@ -259,13 +335,14 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
 
 
 @nb.njit(parallel=True, cache=True)
-def reduce_accumulators(acc, kind, split, start, ncx, ncz, periodic, gx, gz, out, n):
+def reduce_accumulators(acc, kind, split, cl, gx, gz, out, n):
     """out[q, i] = sum_t acc[t, i, q] over the threads that wrote particle i (thread t
     writes the particles of its columns and of the next column); gravity added to fluid
     accelerations.
 
     Returns max |a| over fluid particles (for dt1).
     """
+    start, ncx, ncz, periodic = cl.start, cl.ncx, cl.ncz, cl.periodic
     nt = acc.shape[0]
     nq = acc.shape[2]
     amax = np.zeros(n)

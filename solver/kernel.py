@@ -9,8 +9,16 @@ import numba as nb
 import numpy as np
 
 
-def alpha_2d(h: float) -> float:
+@nb.njit(inline="always", cache=True)
+def alpha_2d(h):
+    """Normalisation alpha = 7 / (4 pi h^2) (the only place it is written)."""
     return 7.0 / (4.0 * math.pi * h * h)
+
+
+@nb.njit(inline="always", cache=True)
+def grad_coefficient(h):
+    """fac = -5 alpha / h^2, so that gradW_ab = grad_factor(q, fac) r_ab."""
+    return -5.0 * alpha_2d(h) / (h * h)
 
 
 @nb.njit(inline="always", cache=True)
@@ -37,5 +45,5 @@ def kernel_gradient(dx: np.ndarray, dz: np.ndarray, h: float):
     """gradW at displacement (dx, dz) = r_ab (zero beyond 2h)."""
     r = np.hypot(dx, dz)
     s = np.clip(1.0 - 0.5 * r / h, 0.0, None)
-    F = -5.0 * alpha_2d(h) / (h * h) * s ** 3
+    F = grad_coefficient(h) * s ** 3
     return F * dx, F * dz

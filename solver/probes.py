@@ -21,29 +21,26 @@ import math
 import numba as nb
 import numpy as np
 
-from .cells import neighbour_cell
-
-from .kernel import w_value
+from .cells import cell_of, neighbour_cell
+from .kernel import alpha_2d, grad_coefficient, w_value
 
 C_SURFACE = 0.5
 
 
 @nb.njit(inline="always", cache=True)
-def _sums(px, pz, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz, ncx, ncz,
-          periodic, period, h, alpha):
+def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
     """(C all, C fluid, sum u V W, sum w V W, sum W fluid) at point (px, pz)."""
     c_all = c_f = su = sw = nw = 0.0
-    if periodic:
-        px = x0 + (px - x0) % period
-    ix = int(math.floor((px - x0) / csx))
-    iz = int(math.floor((pz - z0) / csz))
+    if cl.periodic:
+        px = cl.x0 + (px - cl.x0) % cl.period
+    ix, iz = cell_of(cl, px, pz)
     four_h2 = 4.0 * h * h
     for ddx in range(-1, 2):
         for ddz in range(-1, 2):
-            c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+            c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
             if c < 0:
                 continue
-            for j in range(start[c], start[c + 1]):
+            for j in range(cl.start[c], cl.start[c + 1]):
                 dx = px - (x[j] + shift)
                 dz = pz - z[j]
                 r2 = dx * dx + dz * dz
@@ -61,13 +58,12 @@ def _sums(px, pz, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz, ncx, ncz
 
 
 @nb.njit(parallel=True, cache=True)
-def sample_points(px, pz, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz, ncx, ncz,
-                  periodic, period, h, out):
-    """out[:, k] = (C all, C fluid, Shepard u, Shepard w, sum W fluid) at point k."""
-    alpha = 7.0 / (4.0 * math.pi * h * h)
+def sample_points(px, pz, x, z, u, w, rho, mass, kind, cl, h, out):
+    """out[:, k] = (C all, C fluid, Shepard u, Shepard w, sum W fluid) at point k
+    (``cells.CellList`` cl)."""
+    alpha = alpha_2d(h)
     for k in nb.prange(px.size):
-        c_all, c_f, su, sw, nw = _sums(px[k], pz[k], x, z, u, w, rho, mass, kind, start, x0, z0,
-                                       csx, csz, ncx, ncz, periodic, period, h, alpha)
+        c_all, c_f, su, sw, nw = _sums(px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h, alpha)
         out[0, k] = c_all
         out[1, k] = c_f
         out[2, k] = su / c_f if c_f > 0 else np.nan
@@ -76,20 +72,17 @@ def sample_points(px, pz, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz, 
 
 
 @nb.njit(parallel=True, cache=True)
-def surface_elevation(xs, ztop, zfloor, step, x, z, u, w, rho, mass, kind, start, x0, z0,
-                      csx, csz, ncx, ncz, periodic, period, h, out):
+def surface_elevation(xs, ztop, zfloor, step, x, z, u, w, rho, mass, kind, cl, h, out):
     """Highest z in [zfloor, ztop[k]] where C = 0.5 on the vertical line x = xs[k]
     (zfloor if C < 0.5 all the way down)."""
-    alpha = 7.0 / (4.0 * math.pi * h * h)
+    alpha = alpha_2d(h)
     for k in nb.prange(xs.size):
         zc = ztop[k]
-        c_prev = _sums(xs[k], zc, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz,
-                       ncx, ncz, periodic, period, h, alpha)[0]
+        c_prev = _sums(xs[k], zc, x, z, u, w, rho, mass, kind, cl, h, alpha)[0]
         out[k] = zfloor
         while zc > zfloor:
             zn = max(zc - step, zfloor)
-            c = _sums(xs[k], zn, x, z, u, w, rho, mass, kind, start, x0, z0, csx, csz,
-                      ncx, ncz, periodic, period, h, alpha)[0]
+            c = _sums(xs[k], zn, x, z, u, w, rho, mass, kind, cl, h, alpha)[0]
             if c >= 0.5:
                 if c_prev < 0.5:
                     out[k] = zn + (c - 0.5) / (c - c_prev) * (zc - zn)
@@ -100,26 +93,24 @@ def surface_elevation(xs, ztop, zfloor, step, x, z, u, w, rho, mass, kind, start
 
 
 @nb.njit(parallel=True, cache=True)
-def disorder_moments(idx, x, z, rho, mass, start, x0, z0, csx, csz, ncx, ncz, periodic, period,
-                     h, out):
+def disorder_moments(idx, x, z, rho, mass, cl, h, out):
     """At particles idx, with gradW_ab = F r_ab and V = m / rho (fluid and walls):
     out[:, k] = (M_xx, M_zz, h |sum_b V_b gradW_ab|), M = -sum_b V_b F r_ab r_ab.
     On a regular lattice M = I and the gradient sum is 0; the viscous term sum_b 2 V F u_ab
     approximates M : grad grad u + 2 (sum_b V gradW) . grad u, so both measure how far the
     particle arrangement is from one that makes it the Laplacian."""
-    fac = -5.0 * (7.0 / (4.0 * math.pi * h * h)) / (h * h)
+    fac = grad_coefficient(h)
     four_h2 = 4.0 * h * h
     for k in nb.prange(idx.size):
         a = idx[k]
-        ix = int(math.floor((x[a] - x0) / csx))
-        iz = int(math.floor((z[a] - z0) / csz))
+        ix, iz = cell_of(cl, x[a], z[a])
         mxx = mzz = gx = gz = 0.0
         for ddx in range(-1, 2):
             for ddz in range(-1, 2):
-                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
                 if c < 0:
                     continue
-                for j in range(start[c], start[c + 1]):
+                for j in range(cl.start[c], cl.start[c + 1]):
                     dx = x[a] - (x[j] + shift)
                     dz = z[a] - z[j]
                     r2 = dx * dx + dz * dz
@@ -164,9 +155,8 @@ class FieldSampler:
         self.sim = sim
 
     def _grid_args(self):
-        s, g = self.sim, self.sim.grid
-        return (s.x, s.z, s.u, s.w, s.rho, s.mass, s.kind, s.start, g.x0, g.z0, g.csx, g.csz,
-                g.ncx, g.ncz, g.periodic, g.period, s.h)
+        s = self.sim
+        return (s.x, s.z, s.u, s.w, s.rho, s.mass, s.kind, s.cells, s.h)
 
     def points(self, px, pz) -> np.ndarray:
         px = np.ascontiguousarray(px, dtype=float).ravel()
@@ -177,11 +167,10 @@ class FieldSampler:
 
     def disorder(self, idx) -> np.ndarray:
         """(M_xx, M_zz, h |sum V gradW|) at the particles idx (see ``disorder_moments``)."""
-        s, g = self.sim, self.sim.grid
+        s = self.sim
         idx = np.ascontiguousarray(idx, dtype=np.int64)
         out = np.empty((3, idx.size))
-        disorder_moments(idx, s.x, s.z, s.rho, s.mass, s.start, g.x0, g.z0, g.csx, g.csz,
-                         g.ncx, g.ncz, g.periodic, g.period, s.h, out)
+        disorder_moments(idx, s.x, s.z, s.rho, s.mass, s.cells, s.h, out)
         return out
 
     def surface(self, xs, zfloor: float) -> np.ndarray:

@@ -30,14 +30,14 @@ import math
 import numba as nb
 import numpy as np
 
-from .cells import neighbour_cell
+from .cells import cell_of, neighbour_cell
+from .kernel import grad_coefficient
 
 
 def wall_proximity_at_half_dp(h: float, dp: float) -> float:
     """|sum_b -F(r_ab) n_b| for a particle dp/2 from a flat wall of lattice particles: the
     wall-normal sum of a fluid particle sitting where the lattice puts it."""
-    alpha = 7.0 / (4.0 * math.pi * h * h)
-    fac = -5.0 * alpha / (h * h)
+    fac = grad_coefficient(h)
     n = int(math.ceil(2 * h / dp)) + 1
     i = np.arange(-n, n + 1)
     X, K = np.meshgrid(i * dp, (np.arange(n) + 0.5) * dp + 0.5 * dp)
@@ -78,8 +78,7 @@ SCAN_UPPER = 1.9  # div r below this (and above the threshold): apply the scan-r
 
 
 @nb.njit(parallel=True, cache=True)
-def free_surface(x, z, kind, gcx, gcz, divr, start, n_active, ncx, ncz, periodic, period,
-                 x0, z0, csx, csz, h, thr, upper, flag):
+def free_surface(x, z, kind, gcx, gcz, divr, cl, n_active, h, thr, upper, flag):
     """flag[i] = 1 for free-surface fluid particles: div r < thr, or thr <= div r < upper and
     the scan region of Marrone et al. (2010) is empty. With n = -gradC/|gradC| the outward
     normal and T = r_i + h n, a neighbour j (fluid or wall) occupies it when
@@ -102,15 +101,14 @@ def free_surface(x, z, kind, gcx, gcz, divr, start, n_active, ncx, ncz, periodic
             continue
         nx, nz = -gcx[i] / g, -gcz[i] / g
         tx, tz = x[i] + h * nx, z[i] + h * nz
-        ix = int(math.floor((x[i] - x0) / csx))
-        iz = int(math.floor((z[i] - z0) / csz))
+        ix, iz = cell_of(cl, x[i], z[i])
         occupied = False
         for ddx in range(-1, 2):
             for ddz in range(-1, 2):
-                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
                 if c < 0:
                     continue
-                for j in range(start[c], start[c + 1]):
+                for j in range(cl.start[c], cl.start[c + 1]):
                     if j == i:
                         continue
                     rx = x[j] + shift - x[i]
@@ -135,8 +133,7 @@ def free_surface(x, z, kind, gcx, gcz, divr, start, n_active, ncx, ncz, periodic
 
 
 @nb.njit(cache=True)
-def near_surface(x, z, kind, surface, start, n_active, ncx, ncz, periodic, period, x0, z0,
-                 csx, csz, h, near):
+def near_surface(x, z, kind, surface, cl, n_active, h, near):
     """near[i] = 1 for fluid particles within 2h of a free-surface particle (surface ones
     included). Scattered from the surface particles, which are few: serial."""
     four_h2 = 4.0 * h * h
@@ -146,14 +143,13 @@ def near_surface(x, z, kind, surface, start, n_active, ncx, ncz, periodic, perio
         if not surface[j]:
             continue
         near[j] = 1
-        ix = int(math.floor((x[j] - x0) / csx))
-        iz = int(math.floor((z[j] - z0) / csz))
+        ix, iz = cell_of(cl, x[j], z[j])
         for ddx in range(-1, 2):
             for ddz in range(-1, 2):
-                c, shift = neighbour_cell(ix, iz, ddx, ddz, ncx, ncz, periodic, period)
+                c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
                 if c < 0:
                     continue
-                for i in range(start[c], start[c + 1]):
+                for i in range(cl.start[c], cl.start[c + 1]):
                     if kind[i] != 0:
                         continue
                     ex = x[i] + shift - x[j]

@@ -93,6 +93,11 @@ class Simulation:
         self.cell = np.zeros(self.n, dtype=np.int64)
         self.order = np.zeros(self.n, dtype=np.int64)
         self.start = np.zeros(self.grid.ncells + 2, dtype=np.int64)
+        self.cells = self.grid.cell_list(self.start)  # start is refilled in place by each sort
+        self.constants = forces.PairConstants(
+            h=self.h, nu=self.nu, hc0=self.h * self.c0, rho0=self.rho0,
+            k_hyd=self.rho0 * s.gravity[1] / self.B, k_col=self.rho0 * s.gravity[1] / self.c0 ** 2,
+            delta=self.delta, dp2=s.dp * s.dp)
         self.p = np.zeros(self.n)
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
@@ -116,8 +121,7 @@ class Simulation:
     # ---- pieces of a step -----------------------------------------------------
     def _sort(self) -> str:
         g = self.grid
-        bad = cells.assign_cells(self.x, self.z, self.kind, g.x0, g.z0, g.csx, g.csz,
-                                 g.ncx, g.ncz, self.cell)
+        bad = cells.assign_cells(self.x, self.z, self.kind, self.cells, self.cell)
         if bad >= 0:
             return (f"a fluid particle left the domain x in [{self.domain[0]:.4g}, {self.domain[1]:.4g}], "
                     f"z in [{self.domain[2]:.4g}, {self.domain[3]:.4g}] m at "
@@ -131,7 +135,7 @@ class Simulation:
             self._buf[np.dtype(arr.dtype)] = arr
         self.n_active = int(self.start[g.ncells])
         self.drho_prev[self.n_active:] = 0.0
-        cells.column_split(self.start, g.ncx, g.ncz, self.nthreads, self.split)
+        cells.column_split(self.cells, self.nthreads, self.split)
         return ""
 
     def wall_velocities(self, t: float) -> np.ndarray:
@@ -142,22 +146,20 @@ class Simulation:
         reason = self._sort()
         if reason:
             return reason
-        g, s = self.grid, self.scene
+        s = self.scene
         vwall = self.wall_velocities(t)
         if self.mdbc:
             self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
-                             self.wall, self.gx, self.gz, vwall, self.start, self.n_active,
-                             g.x0, g.z0, g.csx, g.csz, g.ncx, g.ncz, g.periodic, g.period,
+                             self.wall, self.gx, self.gz, vwall, self.cells, self.n_active,
                              self.h, self.rho0)
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
-        self.pair_loop(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
-                       self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.start, g.ncx, g.ncz,
-                       g.periodic, g.period, self.split, self.h, self.nu, self.h * self.c0, self.rho0,
-                       self.rho0 * s.gravity[1] / self.B, self.rho0 * s.gravity[1] / self.c0 ** 2, self.delta, s.dp * s.dp, self.acc, self.vmax_t)
-        self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.start, g.ncx, g.ncz,
-                                               g.periodic, s.gravity[0], s.gravity[1], self.out, self.n)
+        fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
+                                   self.wnx, self.wnz, self.shift_dx, self.shift_dz)
+        self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t)
+        self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.cells,
+                                               s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
         if self.viscous_correction:
             forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active)
@@ -181,7 +183,7 @@ class Simulation:
     def _shift(self, dt: float):
         if self.shift_method == "none":
             return
-        sh, g = self.scene.physics.shifting, self.grid
+        sh = self.scene.physics.shifting
         A = self.scene.shifting_coefficient
         o = self.out
         gcx, gcz, divr = o[forces.GCX], o[forces.GCZ], o[forces.DIVR]
@@ -192,13 +194,11 @@ class Simulation:
                                    self.n_active, A, self.h, dt, sh.surface_threshold, clip,
                                    self.shift_dx, self.shift_dz)
         elif self.shift_method == "lind":
-            shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.start,
-                                  self.n_active, g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0,
-                                  g.csx, g.csz, self.h, sh.surface_threshold, shifting.SCAN_UPPER,
+            shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.cells,
+                                  self.n_active, self.h, sh.surface_threshold, shifting.SCAN_UPPER,
                                   self.surface_flag)
-            shifting.near_surface(self.x, self.z, self.kind, self.surface_flag, self.start,
-                                  self.n_active, g.ncx, g.ncz, g.periodic, g.period, g.x0, g.z0,
-                                  g.csx, g.csz, self.h, self.near_flag)
+            shifting.near_surface(self.x, self.z, self.kind, self.surface_flag, self.cells,
+                                  self.n_active, self.h, self.near_flag)
             shifting.lind_shift(self.kind, gcx, gcz, self.near_flag, wnx, wnz, self.wall_s0,
                                 self.n_active, 0.5 * A * self.h * self.h, clip,
                                 self.shift_dx, self.shift_dz)
@@ -224,7 +224,8 @@ class Simulation:
         reason = self._evaluate(t + 0.5 * dt)
         if reason:
             return self._stop(reason)
-        integrate.kick(self.u, self.w, self.rho, self.kind, self.out[forces.AX], self.out[forces.AZ], self.out[forces.DRHO],
+        o = self.out
+        integrate.kick(self.u, self.w, self.rho, self.kind, o[forces.AX], o[forces.AZ], o[forces.DRHO],
                        self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc)
         vw = self.wall_velocities(t + dt)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,

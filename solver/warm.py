@@ -8,13 +8,12 @@ The belt runs at full speed from t = 0.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
-from .kernel import w_value
+from .kernel import alpha_2d, w_value
 
 
 @dataclass
@@ -42,7 +41,7 @@ class WarmState:
         return pts
 
     def velocity_at(self, px: np.ndarray, pz: np.ndarray, chunk: int = 2000) -> tuple[np.ndarray, np.ndarray]:
-        alpha = 7.0 / (4.0 * math.pi * self.h * self.h)
+        alpha = alpha_2d(self.h)
         u, w = np.zeros(px.size), np.zeros(px.size)
         for k in range(0, px.size, chunk):
             r = np.hypot(px[k:k + chunk, None] - self.x[None], pz[k:k + chunk, None] - self.z[None])

@@ -12,6 +12,8 @@ import pytest
 import xarray as xr
 import yaml
 
+pytestmark = pytest.mark.slow  # runs the solver or Snakemake
+
 ROOT = Path(__file__).resolve().parent.parent
 MINI = ROOT / "tests" / "data" / "mini.yaml"
 

@@ -3,6 +3,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 import xarray as xr
 
 from solver.output import write_atomic
@@ -12,6 +13,7 @@ def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "solver", *args], capture_output=True, text=True)
 
 
+@pytest.mark.slow
 def test_cli_writes_complete_netcdf(tmp_path, examples_dir):
     out = tmp_path / "sub" / "couette.nc"
     p = run_cli("run", str(examples_dir / "couette.yaml"), "-o", str(out), "--threads", "1", "--quiet")
@@ -32,6 +34,7 @@ def test_cli_writes_complete_netcdf(tmp_path, examples_dir):
     assert list(tmp_path.joinpath("sub").iterdir()) == [out]  # no temporary left
 
 
+@pytest.mark.slow
 def test_cli_diverged_run_exit_code_and_file(tmp_path, examples_dir):
     out = tmp_path / "u.nc"
     p = run_cli("run", str(examples_dir / "unstable.yaml"), "-o", str(out), "--quiet")
@@ -41,6 +44,7 @@ def test_cli_diverged_run_exit_code_and_file(tmp_path, examples_dir):
     assert np.isfinite(ds.x).all() and np.isfinite(ds.rho).all()
 
 
+@pytest.mark.slow
 def test_cli_bad_thread_count(tmp_path, examples_dir):
     p = run_cli("run", str(examples_dir / "couette.yaml"), "-o", str(tmp_path / "c.nc"), "--threads", "0")
     assert p.returncode == 2 and "--threads" in p.stderr

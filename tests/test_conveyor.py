@@ -73,6 +73,7 @@ def test_case_errors_name_the_key():
         paper(shifting="magic")
 
 
+@pytest.mark.slow
 def test_killed_run_resumes_to_the_same_result(tmp_path):
     case = tmp_path / "case.yaml"
     with open(EXAMPLES / "conveyor.yaml") as fh:
@@ -149,6 +150,7 @@ def test_warm_start_errors(tmp_path):
         warm.load(tmp_path / "bad.nc")
 
 
+@pytest.mark.slow
 def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
     from solver.front import run_front
     coarse_state(tmp_path / "bad.nc", status="diverged")

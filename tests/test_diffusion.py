@@ -2,6 +2,7 @@
 import math
 
 import numpy as np
+import pytest
 
 from solver.build import build_particles
 from solver.run import run_scene
@@ -21,6 +22,7 @@ def sine_channel(delta, eps=1e-3):
     return Simulation(scene, parts), k
 
 
+@pytest.mark.slow
 def test_diffusion_term_is_a_laplacian_with_coefficient_delta_h_c0():
     """At rest, drho/dt = h c0 D = delta h c0 lap(rho) = -delta h c0 k^2 (rho - rho0)."""
     eps, delta = 1e-3, 0.1
@@ -40,6 +42,7 @@ def test_diffusion_term_is_a_laplacian_with_coefficient_delta_h_c0():
     assert np.all(d["drho"][interior][clear] * expected[clear] > 0)
 
 
+@pytest.mark.slow
 def test_density_bump_decays_faster_with_diffusion():
     def amplitude_after(delta):
         sim, _ = sine_channel(delta, 1e-3)
@@ -67,6 +70,7 @@ def diffusion_rate_at_rest(reference, dp, ch):
     return rate, s["z"][fl], 11 * 0.1 * sc.h * sc.gravity[1] ** 2 / sc.c0 ** 3
 
 
+@pytest.mark.slow
 def test_spec_reference_leaves_a_bulk_density_sink_on_a_column_at_rest():
     """SPEC's rho^H_ab = rho0 ((1 + x)^(1/7) - 1) is exact only for a pair whose upper
     particle is at zero pressure: its curvature in z_b - z_a has the opposite sign to the
@@ -80,6 +84,7 @@ def test_spec_reference_leaves_a_bulk_density_sink_on_a_column_at_rest():
         np.testing.assert_allclose(np.median(rate[mid]), -bulk, rtol=0.05)
 
 
+@pytest.mark.slow
 def test_column_reference_vanishes_on_a_column_at_rest():
     """u = 0 and rho the Tait column at rest (rho^6 linear in depth): the "column" rho^H_ab
     cancels rho_a - rho_b for every pair, bed and surface rows included. Bound: a

@@ -5,6 +5,9 @@ from solver.build import build_particles
 from solver.run import run_scene
 from solver.simulation import Simulation
 from tests.conftest import example_scene
+import pytest
+
+pytestmark = pytest.mark.slow  # runs the solver or Snakemake
 
 
 def run(scene, parts=None):

@@ -22,11 +22,12 @@ SOLVER_DIR = Path(solver.__file__).resolve().parent
 PROBE = """
 import numpy as np
 import solver
+from solver.cells import Grid
 from solver.probes import sample_points
 one = np.zeros(1)
 out = np.zeros((5, 1))
-sample_points(one, one, one, one, one, one, np.ones(1), np.ones(1), np.zeros(1, np.int64),
-              np.array([0, 1]), -1.0, -1.0, 2.0, 2.0, 1, 1, False, 0.0, 0.1, out)
+cl = Grid(-1.0, -1.0, 2.0, 2.0, 1, 1, False, 0.0).cell_list(np.array([0, 1]))
+sample_points(one, one, one, one, one, one, np.ones(1), np.ones(1), np.zeros(1, np.int64), cl, 0.1, out)
 print(repr(float(out[0, 0])), solver.sources.numba_cache_dir())
 """
 

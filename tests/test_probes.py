@@ -8,6 +8,8 @@ from solver.probes import FieldSampler, toe_position
 from solver.scene import scene_from_dict
 from solver.simulation import Simulation
 
+pytestmark = pytest.mark.slow  # runs the solver or Snakemake
+
 DP = 1.0e-3
 H = 0.02
 

@@ -71,6 +71,7 @@ def test_periodic_length_must_be_whole_dp():
     assert "periodic_x" in err({"periodic_x": [0.0, 5.01e-4]})
 
 
+@pytest.mark.slow
 def test_validation_happens_before_compilation(tmp_path, capsys):
     """The CLI rejects a bad scene without importing the numba kernels."""
     import subprocess

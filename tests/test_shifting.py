@@ -9,6 +9,8 @@ from solver.run import run_scene
 from solver.simulation import Simulation
 from tests.conftest import example_scene
 
+pytestmark = pytest.mark.slow  # runs the solver or Snakemake
+
 U = 0.05  # m/s: the skillen shift scales with |u|, so the lattice moves with both walls
 
 

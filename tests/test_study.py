@@ -181,6 +181,7 @@ def dry_run(configfile, tmp_path):
     return counts
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, n", [("config.yaml", 27), ("paper.yaml", 18)])
 def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     counts = dry_run(ROOT / "config" / name, tmp_path)
@@ -189,6 +190,7 @@ def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     assert counts["figures"] == 1 and counts["report_html"] == 1
 
 
+@pytest.mark.slow
 def test_snakemake_rejects_bad_config(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("grid: {dp: [0.001], ch: [1.8], shifting: [magic]}\n")
@@ -197,6 +199,7 @@ def test_snakemake_rejects_bad_config(tmp_path):
     assert p.returncode != 0 and "magic" in (p.stdout + p.stderr)
 
 
+@pytest.mark.slow
 def test_warm_start_chains_each_case_to_the_next_coarser_dp(tmp_path):
     from study.config import case_dict, cases, validate, warm_source
     cfg = validate({"case": {}, "grid": {"dp": [0.003, 0.002, 0.0025], "ch": [1.5], "shifting": ["lind"]},

@@ -8,6 +8,8 @@ from solver import exact
 from solver.run import run_scene
 from tests.conftest import example_scene
 
+pytestmark = pytest.mark.slow  # runs the solver or Snakemake
+
 
 def fluid(snap):
     f = snap["kind"] == 0

@@ -5,6 +5,9 @@ import numpy as np
 from solver.build import build_particles
 from solver.simulation import Simulation
 from tests.conftest import example_scene
+import pytest
+
+pytestmark = pytest.mark.slow  # runs the solver or Snakemake
 
 
 def linear_shear_residual(correction: bool, jitter: float) -> tuple[np.ndarray, float]:

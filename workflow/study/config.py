@@ -10,6 +10,14 @@ from .grid import Case, expand
 
 SCHEMA = Path(__file__).resolve().parent / "config.schema.yaml"
 
+# Campaign keys that every solver case takes as well: (campaign path) -> (solver case path).
+# The schema's default of each must be the solver's default (tests/test_defaults.py).
+SOLVER_KEYS = {
+    ("reference", "normalising_depth"): ("normalising_depth",),
+    ("metrics", "stations"): ("probes", "stations"),
+    ("metrics", "uniform_zone"): ("probes", "uniform_zone"),
+}
+
 
 class ConfigError(ValueError):
     """The campaign configuration is invalid; the message names the key."""
@@ -108,8 +116,15 @@ def case_dict(cfg: dict, case: Case) -> dict:
     if src is not None:
         d.update(start="warm", warm_from=run_path(src))
     d.update(name=case.id, dp=case.dp, ch=case.ch, shifting=case.shifting)
-    d["normalising_depth"] = cfg["reference"]["normalising_depth"]
-    probes = d.setdefault("probes", {})
-    probes.setdefault("stations", list(cfg["metrics"]["stations"]))
-    probes.setdefault("uniform_zone", list(cfg["metrics"]["uniform_zone"]))
+    for cfg_path, case_path in SOLVER_KEYS.items():  # the metrics read what the runs probed
+        node = d
+        for key in case_path[:-1]:
+            node = node.setdefault(key, {})
+        node[case_path[-1]] = copy.deepcopy(_get(cfg, cfg_path))
     return d
+
+
+def _get(tree: dict, path: tuple):
+    for key in path:
+        tree = tree[key]
+    return tree

@@ -1,0 +1,114 @@
+"""Each default is written once: the solver's case dataclasses hold the case defaults, the
+campaign schema holds the campaign's own. What repeats them must agree:
+- the schema's defaults of the keys every solver case also takes (study.config.SOLVER_KEYS);
+- the table of case keys in docs/conveyor.md (every key documented, every default as coded);
+- config/config.yaml and config/stability.yaml set only what differs from a default;
+- config/paper.yaml pins the paper's physical case, which must be the solver's default case.
+"""
+import dataclasses
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+from solver.conveyor import case_from_dict
+from study.config import SOLVER_KEYS, load_schema
+
+ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_CASE = case_from_dict({"dp": 0.001})
+
+
+def _attr(obj, path):
+    for key in path:
+        obj = getattr(obj, key)
+    return obj
+
+
+def _plain(v):
+    return list(v) if isinstance(v, tuple) else v
+
+
+def _schema_default(path):
+    node = load_schema()
+    for key in path:
+        node = node["properties"][key]
+    return node["default"]
+
+
+@pytest.mark.parametrize("cfg_path, case_path", list(SOLVER_KEYS.items()), ids=".".join)
+def test_schema_defaults_are_the_solver_defaults(cfg_path, case_path):
+    assert _schema_default(cfg_path) == _plain(_attr(DEFAULT_CASE, case_path))
+
+
+def _case_fields(obj=DEFAULT_CASE, prefix=""):
+    """Dotted names of every case key, nested dataclasses flattened."""
+    names = []
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if dataclasses.is_dataclass(value):
+            names += _case_fields(value, f"{prefix}{f.name}.")
+        else:
+            names.append(prefix + f.name)
+    return names
+
+
+def _docs_table() -> dict:
+    """{dotted key: default as written} from the case-key table of docs/conveyor.md."""
+    rows = {}
+    text = (ROOT / "docs" / "conveyor.md").read_text()
+    section = text.split("## Case keys", 1)[1].split("\n## ", 1)[0]
+    for line in section.splitlines():
+        m = re.match(r"^\| (`[^|]+`) \| ([^|]+) \|", line)
+        if not m:
+            continue
+        keys = re.findall(r"`([^`]+)`", m.group(1))
+        cell = m.group(2).strip()
+        values = [cell] if cell.startswith("[") else [v.strip() for v in cell.split(", ")]
+        assert len(values) == len(keys), line
+        for k, v in zip(keys, values):
+            rows[k] = v
+    return rows
+
+
+def test_docs_table_lists_every_case_key_with_its_default():
+    table = _docs_table()
+    fields = _case_fields()
+    assert sorted(set(fields) - set(table)) == [], "case keys missing from docs/conveyor.md"
+    assert sorted(set(table) - set(fields)) == [], "docs/conveyor.md lists keys the case does not have"
+    for key in fields:
+        written = table[key]
+        if written == "required":
+            continue
+        assert yaml.safe_load(written.strip("`")) == _plain(_attr(DEFAULT_CASE, key.split("."))), key
+
+
+def _flatten(d, prefix=()):
+    for k, v in d.items():
+        if isinstance(v, dict):
+            yield from _flatten(v, prefix + (k,))
+        else:
+            yield prefix + (k,), v
+
+
+@pytest.mark.parametrize("name", ["config.yaml", "stability.yaml"])
+def test_campaign_configs_set_only_what_differs_from_a_default(name):
+    cfg = yaml.safe_load((ROOT / "config" / name).read_text())
+    restated = [".".join(p) for p, v in _flatten(cfg.get("case", {}))
+                if _plain(_attr(DEFAULT_CASE, p)) == v]
+    for section in ("reference", "metrics", "figures", "resources"):
+        for p, v in _flatten(cfg.get(section, {}), (section,)):
+            try:
+                if _schema_default(p) == v:
+                    restated.append(".".join(p))
+            except KeyError:
+                pass
+    assert restated == []
+
+
+def test_paper_config_pins_the_default_case():
+    cfg = yaml.safe_load((ROOT / "config" / "paper.yaml").read_text())
+    physical = {p: v for p, v in _flatten(cfg["case"]) if p[0] not in ("steady", "checkpoint_interval")}
+    assert physical, "paper.yaml pins no physical key"
+    for p, v in physical.items():
+        assert _plain(_attr(DEFAULT_CASE, p)) == v, ".".join(p)
