@@ -77,3 +77,17 @@ def test_finished_cases_are_not_recomputed(campaign):
     p = snakemake(campaign, MINI, "-n", "--quiet", "rules")
     assert p.returncode == 0, p.stderr
     assert "report_html" in p.stdout and "run_case" not in p.stdout
+
+
+def test_snakemake_report_takes_the_registered_captions(campaign):
+    """``snakemake --report`` packages every registered figure with its caption."""
+    import zipfile
+    from study.figures import FIGURES
+    p = snakemake(campaign, MINI, "--report", "report.zip")
+    assert p.returncode == 0, p.stderr[-4000:]
+    with zipfile.ZipFile(campaign / "report.zip") as z:
+        names = z.namelist()
+        text = "".join(z.read(n).decode("utf-8", "replace") for n in names if n.endswith((".html", ".js")))
+    for spec in FIGURES:
+        assert any(n.endswith(f"{spec.name}.png") for n in names), spec.name
+    assert "Pareto front (no case is both cheaper and more accurate)" in text
