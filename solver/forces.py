@@ -120,6 +120,14 @@ class PairConstants(NamedTuple):
 # ---- the SPEC terms of one pair (a, b), gradW_ab = F r_ab, each inlined into the loop ----
 
 @nb.njit(inline="always", cache=True)
+def continuity_terms(ra, rb, F, vdotr):
+    """(rho_a, rho_b) u_ab . gradW_ab = rho F (u_ab . r_ab): a's term per V_b and b's per V_a
+    (u_ba . gradW_ba is the same product)."""
+    udotg = F * vdotr
+    return ra * udotg, rb * udotg
+
+
+@nb.njit(inline="always", cache=True)
 def pressure_factor(pa, pb, ira, irb, F, fluid_wall):
     """pt = (P_a + P_b) / (rho_a rho_b) F, so that du_a/dt gets -m_b pt r_ab; for a
     fluid-wall pair P_a + P_b is floored at 0 (a wall pushes, never pulls)."""
@@ -246,10 +254,9 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 irb = 1.0 / rb
                                 Vb = mb * irb
                                 inv_r2e = 1.0 / (r2 + eta2)
-                                # continuity: rho_a u_ab . gradW_ab V_b
-                                udotg = F * vdotr
-                                s_drho += ra * udotg * Vb
-                                drho_b = rb * udotg * Va
+                                ca, cb = continuity_terms(ra, rb, F, vdotr)
+                                s_drho += ca * Vb
+                                drho_b = cb * Va
                                 # momentum: pressure and laminar viscosity
                                 pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
                                 vt = laminar_factor(nu, rdotg, ra, rb, inv_r2e)
