@@ -33,11 +33,16 @@ def disorder(x, z, kind, period, dp):
     return d.min(axis=1).std() / dp
 
 
-@pytest.mark.parametrize("method, correction", [("skillen", True), ("lind", False)])
-def test_uniform_lattice_is_not_shifted(method, correction):
-    """The shift law: no concentration gradient, no shift. Lind's per-step density
-    correction amplifies round-off up to its limit (see the rest-channel test below), so the
-    law is checked on the shift alone there."""
+@pytest.mark.parametrize("method, correction, bound", [
+    ("skillen", True, 1e-6),  # skillen's default (correction on): measured 5e-13 dp
+    ("lind", False, 1e-6),  # the shift law alone
+    ("lind", True, 1e-5),  # lind's default: measured 1.6e-6 dp over the 335 steps
+])
+def test_uniform_lattice_is_not_shifted(method, correction, bound):
+    """The shift law: no concentration gradient, no shift; largest displacement in dp against
+    the lattice carried by the flow. Lind's per-step density correction amplifies round-off
+    (up to its limit: see the rest-channel test below), so with it on, the lattice drifts by
+    round-off grown over the run; the bound there is 6x the measured drift."""
     scene = moving_channel(method, density_correction=correction)
     parts = build_particles(scene)
     parts.u[parts.kind == 0] = U
@@ -50,8 +55,8 @@ def test_uniform_lattice_is_not_shifted(method, correction):
     period = scene.periodic_x[1]
     moved = np.mod(x1["x"][f] - x0["x"][f] - U * sim.t + period / 2, period) - period / 2
     assert sim.steps > 50
-    assert np.abs(moved).max() < 1e-6 * scene.dp
-    assert np.abs(x1["z"][f] - x0["z"][f]).max() < 1e-6 * scene.dp
+    assert np.abs(moved).max() < bound * scene.dp
+    assert np.abs(x1["z"][f] - x0["z"][f]).max() < bound * scene.dp
 
 
 @pytest.mark.parametrize("method", ["skillen", "lind"])

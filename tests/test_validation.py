@@ -49,24 +49,51 @@ def startup_channel_errors(name, velocity, exact_u):
     return scene, errors
 
 
-@pytest.mark.parametrize("velocity", ["shepard", "corrected"])
-def test_startup_poiseuille(velocity):
-    L = 1.0e-3
-    scene, errors = startup_channel_errors(
-        "poiseuille", velocity, lambda sc, z, t: exact.poiseuille(z, t, L, sc.gravity[0], sc.nu))
-    u_max = scene.gravity[0] * L ** 2 / (8 * scene.nu)
-    for t, l2 in errors.items():
-        assert l2 <= 0.02 * u_max, f"t = {t}: L2 = {l2 / u_max:.4f} u_max"
+L_CHANNEL = 1.0e-3
+
+# L2 error bounds, % of the velocity scale (u_max of Poiseuille, U0 of Couette) at
+# t = 0.0225, 0.1125, 0.225 s. Each is the value measured on 2026-11-23 (2 threads) plus a
+# 25 % margin, rounded up: measured Poiseuille Shepard 0.093, 0.737, 1.214, corrected 0.229,
+# 0.653, 1.089; Couette Shepard 1.083, 0.687, 0.550, corrected 0.177, 0.239, 0.154.
+BOUNDS = {
+    ("poiseuille", "shepard"): (0.12, 0.93, 1.52),
+    ("poiseuille", "corrected"): (0.29, 0.82, 1.37),
+    ("couette", "shepard"): (1.36, 0.86, 0.69),
+    ("couette", "corrected"): (0.23, 0.30, 0.20),
+}
+_ERRORS = {}
 
 
-@pytest.mark.parametrize("velocity", ["shepard", "corrected"])
-def test_startup_couette(velocity):
-    L = 1.0e-3
-    scene, errors = startup_channel_errors(
-        "couette", velocity, lambda sc, z, t: exact.couette(z, t, L, sc.walls[1].velocity[0], sc.nu))
-    U0 = scene.walls[1].velocity[0]
-    for t, l2 in errors.items():
-        assert l2 <= 0.02 * U0, f"t = {t}: L2 = {l2 / U0:.4f} U0"
+def channel_errors(case: str, velocity: str) -> dict[float, float]:
+    """{t: L2 error / velocity scale} of a start-up channel case (computed once per session)."""
+    if (case, velocity) not in _ERRORS:
+        L = L_CHANNEL
+        if case == "poiseuille":
+            scene, errors = startup_channel_errors(
+                case, velocity, lambda sc, z, t: exact.poiseuille(z, t, L, sc.gravity[0], sc.nu))
+            scale = scene.gravity[0] * L ** 2 / (8 * scene.nu)
+        else:
+            scene, errors = startup_channel_errors(
+                case, velocity, lambda sc, z, t: exact.couette(z, t, L, sc.walls[1].velocity[0], sc.nu))
+            scale = scene.walls[1].velocity[0]
+        _ERRORS[case, velocity] = {t: e / scale for t, e in sorted(errors.items())}
+    return _ERRORS[case, velocity]
+
+
+@pytest.mark.parametrize("case, velocity", list(BOUNDS))
+def test_startup_channel_flow(case, velocity):
+    errors = channel_errors(case, velocity)
+    for (t, err), bound in zip(errors.items(), BOUNDS[case, velocity]):
+        assert 100 * err <= bound, f"t = {t}: L2 = {100 * err:.3f} % of the velocity scale"
+
+
+def test_corrected_ghost_velocity_gains_on_couette():
+    """The first-order corrected ghost velocity removes most of the wall-slip error of the
+    Shepard ghost velocity where the wall moves (Couette: 3.7x to 6.1x measured); on
+    Poiseuille, driven by a body force with walls at rest, it gains nothing at the start."""
+    shepard, corrected = channel_errors("couette", "shepard"), channel_errors("couette", "corrected")
+    for t in shepard:
+        assert corrected[t] <= shepard[t] / 2.5, f"t = {t}: {corrected[t]:.5f} vs {shepard[t]:.5f}"
 
 
 def test_film_on_incline_reaches_semi_parabolic_profile():
