@@ -58,12 +58,44 @@ def _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, b0, b1, b2):
     return y0, y1, y2
 
 
+@nb.njit(inline="always", cache=True)
+def number_density_floor(i, x, z, cl, h, alpha, dp2, rho0, n_lattice):
+    """rho0 n_i / n_lattice, n_i = sum_j dp^2 W(r_i - r_j) over every particle (fluid and
+    wall, i itself included) around boundary particle i: above rho0 only where particles
+    crowd closer than the lattice, i.e. where fluid is pressed into the wall."""
+    ix, iz = cell_of(cl, x[i], z[i])
+    four_h2 = 4.0 * h * h
+    n = 0.0
+    for ddx in range(-1, 2):
+        for ddz in range(-1, 2):
+            c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
+            if c < 0:
+                continue
+            for j in range(cl.start[c], cl.start[c + 1]):
+                dx = x[i] - (x[j] + shift)
+                dz = z[i] - z[j]
+                r2 = dx * dx + dz * dz
+                if r2 < four_h2:
+                    n += w_value(math.sqrt(r2) / h, alpha)
+    return rho0 * n * dp2 / n_lattice
+
+
+def lattice_number_density(ch: float) -> float:
+    """sum_j dp^2 W(r_j) over a full square lattice around one of its nodes, h = ch dp."""
+    m = int(math.ceil(2.0 * ch)) + 1
+    i = np.arange(-m, m + 1, dtype=float)
+    r = np.hypot(*np.meshgrid(i, i)).ravel() / ch  # q = r / h
+    r = r[r < 2.0]
+    return float((7.0 / (4.0 * math.pi * ch * ch) * (1 - r / 2) ** 4 * (2 * r + 1)).sum())
+
+
 @functools.cache
-def make_mdbc_update(corrected_velocity: bool):
-    """Compile the mDBC update with the Shepard or the corrected ghost velocity."""
+def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
+    """Compile the mDBC update with the Shepard or the corrected ghost velocity; with
+    ``no_penetration`` each boundary density is floored by ``number_density_floor``."""
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-    def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, h, rho0):
+    def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, h, rho0, dp2, n_lattice):
         """Set density and no-slip velocity of every active boundary particle from its ghost.
 
         v_g is Shepard-interpolated (SPEC), or first-order corrected like the density when
@@ -78,8 +110,11 @@ def make_mdbc_update(corrected_velocity: bool):
                 continue
             gx, gz = gxs[i], gzs[i]
             vwx, vwz = vwall[wall[i], 0], vwall[wall[i], 1]
+            floor = rho0
+            if no_penetration:
+                floor = max(rho0, number_density_floor(i, x, z, cl, h, alpha, dp2, rho0, n_lattice))
             if not math.isfinite(gx):
-                rho[i] = rho0
+                rho[i] = floor
                 u[i] = vwx
                 w[i] = vwz
                 continue
@@ -131,7 +166,7 @@ def make_mdbc_update(corrected_velocity: bool):
                             bw1 += w[j] * gxv * h
                             bw2 += w[j] * gzv * h
             if a00 <= 0.0:
-                rho[i] = rho0
+                rho[i] = floor
                 u[i] = vwx
                 w[i] = vwz
                 continue
@@ -155,7 +190,7 @@ def make_mdbc_update(corrected_velocity: bool):
             else:
                 ug = su / a00
                 wg = sw / a00
-            rho[i] = max(rb, rho0)  # walls push, never pull: no tension at a wall
+            rho[i] = max(rb, floor)  # walls push, never pull: no tension at a wall
             u[i] = 2.0 * vwx - ug
             w[i] = 2.0 * vwz - wg
 

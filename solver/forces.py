@@ -115,6 +115,7 @@ class PairConstants(NamedTuple):
     k_col: float
     delta: float
     dp2: float
+    av: float  # alpha h c0 of the artificial viscosity (0: off)
 
 
 # ---- the SPEC terms of one pair (a, b), gradW_ab = F r_ab, each inlined into the loop ----
@@ -142,6 +143,16 @@ def laminar_factor(nu, rdotg, ra, rb, inv_r2e):
     """vt = 4 nu (r_ab . gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)), so that du_a/dt gets
     m_b vt u_ab (Lo & Shao)."""
     return 4.0 * nu * rdotg / (ra + rb) * inv_r2e
+
+
+@nb.njit(inline="always", cache=True)
+def artificial_factor(av, vdotr, ra, rb, inv_r2e, F):
+    """Monaghan's Pi_ab F, so that du_a/dt gets -m_b Pi_ab F r_ab:
+    Pi_ab = -alpha h c0 (u_ab . r_ab) / (rho_ab (r^2 + eta^2)), rho_ab = (rho_a + rho_b) / 2,
+    for approaching pairs (u_ab . r_ab < 0), 0 otherwise; av = alpha h c0."""
+    if vdotr >= 0.0:
+        return 0.0
+    return -2.0 * av * vdotr / (ra + rb) * inv_r2e * F
 
 
 @nb.njit(inline="always", cache=True)
@@ -176,11 +187,13 @@ def concentration_terms(dp2, F, dx, dz, rdotg):
 
 @functools.cache
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
-                   column_reference: bool = False, viscous_correction: bool = False):
+                   column_reference: bool = False, viscous_correction: bool = False,
+                   artificial: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
     divergence (for the density correction) in or out; ``column_reference`` picks the
     diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
-    of ``correct_viscous_term``."""
+    of ``correct_viscous_term``; ``artificial`` adds Monaghan's artificial viscosity (all
+    pairs, walls included, as DualSPHysics)."""
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
     def pair_loop(f, cl, split, k, acc, vmax):
@@ -260,6 +273,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 # momentum: pressure and laminar viscosity
                                 pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
                                 vt = laminar_factor(nu, rdotg, ra, rb, inv_r2e)
+                                if artificial:
+                                    pt += artificial_factor(k.av, vdotr, ra, rb, inv_r2e, F)
                                 fx = -pt * dx + vt * du
                                 fz = -pt * dz + vt * dw
                                 s_ax += mb * fx

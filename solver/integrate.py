@@ -49,13 +49,16 @@ def advance_density(rho, drho, n, c):
 
 
 @nb.njit(parallel=True, cache=True)
-def kick(u, w, rho, kind, ax, az, drho, drho_prev, n, dt, rho0, clamp_boundary):
-    """v += dt a (fluid); rho^{n+1} = rho^{n+1/2} + dt (drho - drho_prev / 2)."""
+def kick(u, w, rho, kind, ax, az, drho, drho_prev, n, dt, rho0, clamp_boundary, clamp_fluid):
+    """v += dt a (fluid); rho^{n+1} = rho^{n+1/2} + dt (drho - drho_prev / 2); rho floored at
+    rho0 for boundary particles (``clamp_boundary``, DBC) and fluid (``clamp_fluid``: no tension)."""
     for i in nb.prange(n):
         rho[i] += dt * (drho[i] - 0.5 * drho_prev[i])
         if kind[i] == 0:
             u[i] += dt * ax[i]
             w[i] += dt * az[i]
+            if clamp_fluid and rho[i] < rho0:
+                rho[i] = rho0
         elif clamp_boundary and rho[i] < rho0:
             rho[i] = rho0
         drho_prev[i] = drho[i]

@@ -133,11 +133,17 @@ class Shifting:
 class Physics:
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"  # ghost velocity: shepard (SPEC) or corrected (first order)
+    # floor each wall density by the particle number density around it (fluid pressed into a wall)
+    no_penetration: bool = False
     density_diffusion: float | None = 0.1  # delta; null/false switches it off
     # rho^H_ab of the diffusion: spec (SPEC's printed form) or column (the Tait column at rest)
     density_diffusion_reference: str = "spec"
     # remove the laminar term's first-order error 2 nu G . grad u where the support is full
     viscous_correction: bool = False
+    # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
+    artificial_viscosity: float | None = None
+    # floor the fluid density at rho0 after each step: no negative pressure, no tensile clumping
+    no_tension: bool = False
     shifting: Shifting = field(default_factory=Shifting)
 
 
@@ -372,6 +378,9 @@ def validate(scene: Scene) -> None:
             f"physics.mdbc_velocity: {ph.mdbc_velocity!r} is not one of {', '.join(MDBC_VELOCITY)}")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
+    if ph.artificial_viscosity is not None and not 0 <= ph.artificial_viscosity <= 1:
+        raise SceneError("physics.artificial_viscosity: must lie in [0, 1] (DualSPHysics' default "
+                         f"is 0.01) or be null, got {ph.artificial_viscosity}")
     if ph.density_diffusion_reference not in DIFFUSION_REFERENCES:
         raise SceneError(f"physics.density_diffusion_reference: {ph.density_diffusion_reference!r} "
                          f"is not one of {', '.join(DIFFUSION_REFERENCES)}")

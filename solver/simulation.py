@@ -71,10 +71,13 @@ class Simulation:
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction)
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
                                                 s.physics.density_diffusion_reference == "column",
-                                                self.viscous_correction)
+                                                self.viscous_correction,
+                                                bool(s.physics.artificial_viscosity))
         self.sorted_fields = _SORTED + (_SHIFT if self.correct_shift else ())
         self.mdbc = s.physics.boundary == "mdbc"
-        self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected")
+        self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
+                                                     bool(s.physics.no_penetration))
+        self.n_lattice = boundary.lattice_number_density(s.ch)
 
         x0, x1, z0, z1 = default_domain(s)
         self.domain = (x0, x1, z0, z1)
@@ -97,7 +100,7 @@ class Simulation:
         self.constants = forces.PairConstants(
             h=self.h, nu=self.nu, hc0=self.h * self.c0, rho0=self.rho0,
             k_hyd=self.rho0 * s.gravity[1] / self.B, k_col=self.rho0 * s.gravity[1] / self.c0 ** 2,
-            delta=self.delta, dp2=s.dp * s.dp)
+            delta=self.delta, dp2=s.dp * s.dp, av=(s.physics.artificial_viscosity or 0.0) * self.h * self.c0)
         self.p = np.zeros(self.n)
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
@@ -151,7 +154,7 @@ class Simulation:
         if self.mdbc:
             self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
                              self.wall, self.gx, self.gz, vwall, self.cells, self.n_active,
-                             self.h, self.rho0)
+                             self.h, self.rho0, s.dp * s.dp, self.n_lattice)
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
@@ -226,7 +229,8 @@ class Simulation:
             return self._stop(reason)
         o = self.out
         integrate.kick(self.u, self.w, self.rho, self.kind, o[forces.AX], o[forces.AZ], o[forces.DRHO],
-                       self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc)
+                       self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc,
+                       bool(s.physics.no_tension))
         vw = self.wall_velocities(t + dt)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
                         vw, self.moving, 0.5 * dt, self.n)
