@@ -12,6 +12,9 @@ include: "workflow/rules/analyse.smk"
 include: "workflow/rules/report.smk"
 
 
+localrules: all, case_file  # writing a case's YAML is no cluster job
+
+
 rule all:
     input:
         "reports/report.html",

@@ -55,10 +55,10 @@ rm -rf "$WORK"; mkdir -p "$WORK"
 cd "$WORK"
 # the profile's resources, with this cluster's partition; squeue polls the job states
 snakemake -s "$ROOT/Snakefile" --configfile "$ROOT/tests/data/mini.yaml" \
-    --profile "$ROOT/profiles/slurm" --default-resources slurm_partition=local \
+    --profile "$ROOT/profiles/slurm" --default-resources slurm_partition=local runtime=10 mem_mb=1000 \
     --set-resources run_case:cpus_per_task=1 run_case:mem_mb=2000 \
     --set-threads run_case=1 --slurm-status-command squeue --jobs 4 \
     2>&1 | tee "$WORK/snakemake.log"
 echo "--- jobs (squeue, finished ones kept for MinJobAge):"
-squeue -t all -o "%.8i %.28j %.10T %.10M %.4C"
+squeue -t all -o "%.6i %.45k %.10T %.8M %.4C"
 ls -l "$WORK/reports/report.html"
