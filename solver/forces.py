@@ -50,8 +50,9 @@ VGX, VGZ, DUX, DUZ, DWX, DWZ, VDIVR = 9, 10, 11, 12, 13, 14, 15
 NQ_BASE, NQ_SHIFT, NQ_CORRECTED, NQ_VISCOUS = 3, 8, 9, 16
 
 
-def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False) -> int:
-    if viscous_correction:
+def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
+            velocity_gradient: bool = False) -> int:
+    if viscous_correction or velocity_gradient:
         return NQ_VISCOUS
     return NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
 
@@ -102,6 +103,7 @@ class PairFields(NamedTuple):
     wnz: np.ndarray
     sdx: np.ndarray
     sdz: np.ndarray
+    nu_p: np.ndarray  # each particle's kinematic viscosity (read with variable_viscosity only)
 
 
 class PairConstants(NamedTuple):
@@ -143,6 +145,17 @@ def laminar_factor(nu, rdotg, ra, rb, inv_r2e):
     """vt = 4 nu (r_ab . gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)), so that du_a/dt gets
     m_b vt u_ab (Lo & Shao)."""
     return 4.0 * nu * rdotg / (ra + rb) * inv_r2e
+
+
+@nb.njit(inline="always", cache=True)
+def pair_viscosity(nu_a, nu_b, fluid_wall, a_is_fluid):
+    """nu_ab: the geometric mean sqrt(nu_a nu_b) of two fluid particles; for a fluid-wall pair
+    the fluid particle's own. Across a yield surface the two differ by up to mu_max / mu; the
+    harmonic mean lets the plug edge shear too much, the arithmetic one too little
+    (docs/numerics.md, "Herschel-Bulkley")."""
+    if fluid_wall:
+        return nu_a if a_is_fluid else nu_b
+    return math.sqrt(nu_a * nu_b)
 
 
 @nb.njit(inline="always", cache=True)
@@ -188,12 +201,15 @@ def concentration_terms(dp2, F, dx, dz, rdotg):
 @functools.cache
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
                    column_reference: bool = False, viscous_correction: bool = False,
-                   artificial: bool = False):
+                   artificial: bool = False, variable_viscosity: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
     divergence (for the density correction) in or out; ``column_reference`` picks the
     diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
     of ``correct_viscous_term``; ``artificial`` adds Monaghan's artificial viscosity (all
-    pairs, walls included, as DualSPHysics)."""
+    pairs, walls included, as DualSPHysics); ``variable_viscosity`` takes each pair's
+    viscosity from the particles' nu_p (``pair_viscosity``) and sums the velocity gradient
+    into slots DUX..DWZ (``rheology``)."""
+    velocity_gradient = viscous_correction or variable_viscosity
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
     def pair_loop(f, cl, split, k, acc, vmax):
@@ -272,7 +288,11 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 drho_b = cb * Va
                                 # momentum: pressure and laminar viscosity
                                 pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
-                                vt = laminar_factor(nu, rdotg, ra, rb, inv_r2e)
+                                if variable_viscosity:
+                                    nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
+                                    vt = laminar_factor(nu_ab, rdotg, ra, rb, inv_r2e)
+                                else:
+                                    vt = laminar_factor(nu, rdotg, ra, rb, inv_r2e)
                                 if artificial:
                                     pt += artificial_factor(k.av, vdotr, ra, rb, inv_r2e, F)
                                 fx = -pt * dx + vt * du
@@ -316,6 +336,9 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     s_vgz += Vb * F * dz
                                     at[b, VGX] -= Va * F * dx
                                     at[b, VGZ] -= Va * F * dz
+                                    s_vdivr -= Vb * rdotg
+                                    at[b, VDIVR] -= Va * rdotg
+                                if velocity_gradient:
                                     # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
                                     s_dux -= Vb * du * F * dx
                                     s_duz -= Vb * du * F * dz
@@ -325,8 +348,6 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     at[b, DUZ] -= Va * du * F * dz
                                     at[b, DWX] -= Va * dw * F * dx
                                     at[b, DWZ] -= Va * dw * F * dz
-                                    s_vdivr -= Vb * rdotg
-                                    at[b, VDIVR] -= Va * rdotg
                                 if shift_correction:
                                     # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
                                     e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
@@ -346,11 +367,12 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             if viscous_correction:
                                 at[a, VGX] += s_vgx
                                 at[a, VGZ] += s_vgz
+                                at[a, VDIVR] += s_vdivr
+                            if velocity_gradient:
                                 at[a, DUX] += s_dux
                                 at[a, DUZ] += s_duz
                                 at[a, DWX] += s_dwx
                                 at[a, DWZ] += s_dwz
-                                at[a, VDIVR] += s_vdivr
             vmax[t] = vm
 
     return pair_loop

@@ -93,9 +93,20 @@ class Wall(Rect):
 @dataclass
 class Fluid:
     density: float
-    viscosity: float  # dynamic viscosity mu [Pa s]
+    viscosity: float | None = None  # dynamic viscosity mu [Pa s] (newtonian)
     blocks: list[FluidBlock] = field(default_factory=list)
     profiles: list[FluidProfile] = field(default_factory=list)
+    # herschel_bulkley: tau = tau_y + K gamma^n where yielded, mu = min(mu_max, tau / gamma)
+    rheology: str = "newtonian"
+    yield_stress: float = 0.0  # tau_y [Pa]
+    consistency: float | None = None  # K [Pa s^n]
+    index: float = 1.0  # n
+    max_viscosity: float | None = None  # mu_max [Pa s]: the regularisation's cap
+    papanastasiou: float | None = None  # m [s]: tau_y (1 - exp(-m gamma)) / gamma below the cap
+
+    @property
+    def newtonian(self) -> bool:
+        return self.rheology == "newtonian"
 
     def extents(self) -> list[Rect]:
         """Bounding rectangles of every fluid region."""
@@ -200,7 +211,10 @@ class Scene(YamlData):
 
     @property
     def nu(self) -> float:
-        return self.fluid.viscosity / self.fluid.density
+        """Kinematic viscosity; for a Herschel-Bulkley fluid its cap mu_max / rho (the largest
+        one, which bounds the viscous time step)."""
+        f = self.fluid
+        return (f.viscosity if f.newtonian else f.max_viscosity) / f.density
 
     @property
     def c0(self) -> float:
@@ -342,6 +356,39 @@ def _interval(pair, key):
         raise SceneError(f"{key}: upper bound must exceed lower bound, got {list(pair)}")
 
 
+RHEOLOGIES = ("newtonian", "herschel_bulkley")
+
+
+def _validate_rheology(scene: Scene) -> None:
+    f = scene.fluid
+    if f.rheology not in RHEOLOGIES:
+        raise SceneError(f"fluid.rheology: {f.rheology!r} is not one of {', '.join(RHEOLOGIES)}")
+    if f.newtonian:
+        if f.viscosity is None:
+            raise SceneError("fluid.viscosity: required for rheology newtonian (mu [Pa s])")
+        _positive(f.viscosity, "fluid.viscosity")
+        for key in ("consistency", "max_viscosity", "papanastasiou"):
+            if getattr(f, key) is not None:
+                raise SceneError(f"fluid.{key}: only for rheology herschel_bulkley")
+        if f.yield_stress != 0.0 or f.index != 1.0:
+            raise SceneError("fluid.yield_stress, fluid.index: only for rheology herschel_bulkley")
+        return
+    if f.viscosity is not None:
+        raise SceneError("fluid.viscosity: not used by rheology herschel_bulkley "
+                         "(give consistency K, index n, yield_stress and max_viscosity)")
+    for key in ("consistency", "max_viscosity"):
+        if getattr(f, key) is None:
+            raise SceneError(f"fluid.{key}: required for rheology herschel_bulkley")
+        _positive(getattr(f, key), f"fluid.{key}")
+    _positive(f.index, "fluid.index")
+    if not (f.yield_stress >= 0 and math.isfinite(f.yield_stress)):
+        raise SceneError(f"fluid.yield_stress: must be >= 0, got {f.yield_stress}")
+    if f.papanastasiou is not None:
+        _positive(f.papanastasiou, "fluid.papanastasiou")
+    if scene.physics.viscous_correction:
+        raise SceneError("physics.viscous_correction: only for rheology newtonian")
+
+
 def validate(scene: Scene) -> None:
     """Check physical and geometric consistency; raise SceneError naming the key."""
     _positive(scene.dp, "dp")
@@ -350,7 +397,7 @@ def validate(scene: Scene) -> None:
         raise SceneError(f"ch: h/dp must lie in [0.5, 4], got {scene.ch}")
     _positive(scene.cfl, "cfl")
     _positive(scene.fluid.density, "fluid.density")
-    _positive(scene.fluid.viscosity, "fluid.viscosity")
+    _validate_rheology(scene)
     if not scene.fluid.blocks and not scene.fluid.profiles:
         raise SceneError("fluid: at least one of fluid.blocks or fluid.profiles is required")
     s = scene.sound

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from . import boundary, cells, forces, guards, integrate, shifting
+from . import boundary, cells, forces, guards, integrate, rheology, shifting
 from .build import Particles, build_particles
 from .scene import Scene
 
@@ -58,6 +58,10 @@ class Simulation:
         self.wnx, self.wnz = np.where(norm > 0, gdx / safe, 0.0), np.where(norm > 0, gdz / safe, 0.0)
         self.drho_prev = np.zeros(self.n)
         self.n_fluid = int((self.kind == 0).sum())
+        # each particle's kinematic viscosity (Herschel-Bulkley: from the last strain rate;
+        # at rest the cap mu_max / rho0)
+        self.nu_p = np.full(self.n, scene.nu)
+        self.nu_max_now = scene.nu
 
         s = scene
         self.h, self.rho0, self.c0, self.nu = s.h, s.fluid.density, s.c0, s.nu
@@ -68,12 +72,16 @@ class Simulation:
         shifting_on = self.shift_method != "none"
         self.correct_shift = shifting_on and s.shift_density_correction
         self.viscous_correction = bool(s.physics.viscous_correction)
-        self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction)
+        self.variable_viscosity = not s.fluid.newtonian
+        self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
+                                 self.variable_viscosity)
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
                                                 s.physics.density_diffusion_reference == "column",
                                                 self.viscous_correction,
-                                                bool(s.physics.artificial_viscosity))
-        self.sorted_fields = _SORTED + (_SHIFT if self.correct_shift else ())
+                                                bool(s.physics.artificial_viscosity),
+                                                self.variable_viscosity)
+        self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
+                              + (("nu_p",) if self.variable_viscosity else ()))
         self.mdbc = s.physics.boundary == "mdbc"
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
@@ -159,13 +167,18 @@ class Simulation:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
-                                   self.wnx, self.wnz, self.shift_dx, self.shift_dz)
+                                   self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.cells,
                                                s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
         if self.viscous_correction:
             forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active)
+        if self.variable_viscosity:  # the viscosity of the next evaluation
+            fl = s.fluid
+            self.nu_max_now = rheology.update_viscosity(
+                self.out, self.kind, self.nu_p, self.n_active, self.rho0, fl.yield_stress,
+                fl.consistency, fl.index, fl.max_viscosity, fl.papanastasiou or 0.0)
         if self.correct_shift:
             self._correct_density()
         return ""
@@ -180,7 +193,8 @@ class Simulation:
         self.shift_dz[:] = 0.0
 
     def _update_dt(self):
-        dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0, self.nu)
+        dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0,
+                                         self.nu_max_now)
         self.info = StepInfo(dt, k, lim)
 
     def _shift(self, dt: float):
@@ -259,7 +273,8 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFT + ("t", "steps", "info", "dt_first", "n_active", "reason")
+    _STATE = _SORTED + _SHIFT + ("nu_p", "nu_max_now", "t", "steps", "info", "dt_first", "n_active",
+                                 "reason")
 
     def state(self) -> dict:
         """Everything needed to resume exactly where this simulation stands."""
