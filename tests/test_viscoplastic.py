@@ -1,0 +1,41 @@
+"""Lubrication theory of a Herschel-Bulkley front (solver/viscoplastic.py)."""
+import math
+
+import numpy as np
+import pytest
+
+from solver import lubrication
+from solver.viscoplastic import HBFluid, driving_slope, front_profile, normal_depth
+
+G, THETA, U_B = 9.81, math.radians(15.3), 0.075
+
+
+def test_newtonian_limit_is_spec_section_5():
+    newt = HBFluid(rho=1383.0, tau_y=0.0, K=5.6, n=1.0)
+    h_n = normal_depth(newt, U_B, G, THETA)
+    assert h_n == pytest.approx(lubrication.normal_depth(5.6, U_B, 1383.0, G, THETA), rel=1e-10)
+    xi, eta = front_profile(newt, U_B, G, THETA, eta_max=0.99)
+    assert np.interp(0.9, eta, xi) == pytest.approx(float(lubrication.xi_star(0.9, THETA)), rel=1e-4)
+    z = np.linspace(0, 0.8 * h_n, 7)
+    S = driving_slope(newt, 0.8 * h_n, U_B, G)
+    assert newt.film(z, 0.8 * h_n, S, G) / U_B == pytest.approx(
+        lubrication.belt_velocity(z / (0.8 * h_n)), rel=1e-9)
+
+
+def test_carbopol_like_fluid():
+    """rho 1000, tau_y 20 Pa, K 10 Pa s^n, n 0.4 on the paper's slope and belt: h_n about 2 cm;
+    the flux relative to the belt is u_b h at every depth; the plug takes the top of the film."""
+    fluid = HBFluid(rho=1000.0, tau_y=20.0, K=10.0, n=0.4)
+    h_n = normal_depth(fluid, U_B, G, THETA)
+    assert 0.015 < h_n < 0.03, h_n
+    S = math.sin(THETA)
+    assert fluid.flux(h_n, S, G) == pytest.approx(U_B * h_n, rel=1e-10)
+    plug = fluid.tau_y / (fluid.rho * G * S)
+    assert 0 < plug < h_n
+    for eta in (0.2, 0.6, 0.95):
+        h = eta * h_n
+        Sh = driving_slope(fluid, h, U_B, G)
+        assert Sh > S  # shallower than h_n: steeper driving slope
+        assert fluid.flux(h, Sh, G) == pytest.approx(U_B * h, rel=1e-10)
+    xi, eta = front_profile(fluid, U_B, G, THETA)
+    assert np.all(np.diff(xi) > 0) and eta[-1] == pytest.approx(0.999)
