@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import lubrication
+from . import lubrication, viscoplastic
 from .scene import Scene, SceneError, YamlData, parse_into, scene_from_dict
 from .steady import SteadyCriteria
 
@@ -65,7 +65,13 @@ class ConveyorCase(YamlData):
     shift_correction_limit: float | None = None  # null: the method's default
     shift_max: float | None = None  # clip of each shift component in dp; null: the scene default
     density: float = 1383.0
-    viscosity: float = 5.6
+    viscosity: float = 5.6  # mu [Pa s] of a newtonian fluid (not used by herschel_bulkley)
+    rheology: str = "newtonian"  # or herschel_bulkley (the scene's fluid keys below)
+    yield_stress: float = 0.0
+    consistency: float | None = None
+    index: float = 1.0
+    max_viscosity: float | None = None
+    papanastasiou: float | None = None
     slope_deg: float = 15.3
     gravity: float = 9.81
     belt: Belt = field(default_factory=Belt)
@@ -93,10 +99,30 @@ class ConveyorCase(YamlData):
         return math.radians(self.slope_deg)
 
     @property
+    def newtonian(self) -> bool:
+        return self.rheology == "newtonian"
+
+    @property
+    def hb_fluid(self) -> viscoplastic.HBFluid:
+        return viscoplastic.HBFluid(self.density, self.yield_stress, self.consistency, self.index)
+
+    @property
     def h_n(self) -> float:
-        """Normal depth from the flux balance, eq. 13b."""
-        return lubrication.normal_depth(self.viscosity, self.belt.speed, self.density,
-                                        self.gravity, self.theta)
+        """Normal depth from the flux balance: eq. 13b, or zero lab-frame flux of the
+        Herschel-Bulkley film (``viscoplastic.normal_depth``)."""
+        if self.newtonian:
+            return lubrication.normal_depth(self.viscosity, self.belt.speed, self.density,
+                                            self.gravity, self.theta)
+        return viscoplastic.normal_depth(self.hb_fluid, self.belt.speed, self.gravity, self.theta)
+
+    def front_shape(self):
+        """(x*, eta) of the steady lubrication front from the toe, for either rheology."""
+        if self.newtonian:
+            eta = np.concatenate([np.linspace(0.0, 0.99, 300, endpoint=False),
+                                  1 - np.geomspace(0.01, 1e-9, 300)])
+            return lubrication.xi_star(eta, self.theta), eta
+        return viscoplastic.front_profile(self.hb_fluid, self.belt.speed, self.gravity, self.theta,
+                                          eta_max=1 - 1e-6)
 
     @property
     def running_start(self) -> bool:
@@ -140,6 +166,9 @@ def validate_case(c: ConveyorCase) -> None:
     if c.start == "warm" and c.start_velocity != "rest":
         raise SceneError("case.start_velocity: a warm start takes its velocities from warm_from; "
                          "leave start_velocity at rest")
+    if not c.newtonian and c.start_velocity != "rest":
+        raise SceneError("case.start_velocity: the lubrication start velocity is for newtonian "
+                         "fluids; a herschel_bulkley case starts at rest")
     if c.start == "warm" and not c.warm_from:
         raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")
@@ -187,21 +216,33 @@ def initial_toe(c: ConveyorCase, warm=None) -> float:
         return warm.toe
     if c.start == "block":
         return c.fluid_length * hn
-    return (c.fluid_length + lubrication.front_area_deficit(c.theta)) * hn
+    if c.newtonian:
+        return (c.fluid_length + lubrication.front_area_deficit(c.theta)) * hn
+    xs, eta = c.front_shape()
+    deficit = float(np.sum(np.diff(xs) * (1 - 0.5 * (eta[1:] + eta[:-1]))))
+    return (c.fluid_length + deficit) * hn
 
 
 def front_surface(c: ConveyorCase, n: int = 600) -> list[list[float]]:
     """Points of the lubrication front surface from the wall (x = 0) to the toe, with the
     area of a block of length fluid_length h_n at depth h_n."""
     hn, x_toe = c.h_n, initial_toe(c)
-    eta = np.concatenate([np.linspace(0.0, 0.99, n // 2, endpoint=False),
-                          1 - np.geomspace(0.01, 1e-9, n // 2)])
-    xi = lubrication.xi_star(eta, c.theta) * hn
+    if c.newtonian:
+        eta = np.concatenate([np.linspace(0.0, 0.99, n // 2, endpoint=False),
+                              1 - np.geomspace(0.01, 1e-9, n // 2)])
+        xi = lubrication.xi_star(eta, c.theta) * hn
+        eta_wall = lubrication.front_eta(x_toe / hn, c.theta)
+    else:
+        xs, eta = c.front_shape()
+        xi = xs * hn
+        eta_wall = float(np.interp(x_toe / hn, xs, eta))
     x = x_toe - xi
     keep = x > 0
     x, z = x[keep][::-1], (eta * hn)[keep][::-1]
     x = np.concatenate([[0.0], x])
-    z = np.concatenate([[hn * lubrication.front_eta(x_toe / hn, c.theta)], z])
+    z = np.concatenate([[hn * eta_wall], z])
+    distinct = np.concatenate([[True], np.diff(x) > 1e-9 * hn])  # the tip's points crowd at x_toe
+    x, z = x[distinct], z[distinct]
     return [[float(a), float(b)] for a, b in zip(x, z)]
 
 
@@ -241,7 +282,7 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,
-        "fluid": {"density": c.density, "viscosity": c.viscosity, **fluid},
+        "fluid": {"density": c.density, **_rheology(c), **fluid},
         "walls": [
             {"name": "belt", "x": [belt_start, belt_end], "z": [-T, 0.0],
              "velocity": [-c.belt.speed, 0.0], "moving": False,
@@ -259,6 +300,13 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,
     }
+
+
+def _rheology(c: ConveyorCase) -> dict:
+    if c.newtonian:
+        return {"viscosity": c.viscosity}
+    return {"rheology": c.rheology, "yield_stress": c.yield_stress, "consistency": c.consistency,
+            "index": c.index, "max_viscosity": c.max_viscosity, "papanastasiou": c.papanastasiou}
 
 
 def build_scene(c: ConveyorCase, warm=None) -> Scene:

@@ -39,3 +39,42 @@ def test_carbopol_like_fluid():
         assert fluid.flux(h, Sh, G) == pytest.approx(U_B * h, rel=1e-10)
     xi, eta = front_profile(fluid, U_B, G, THETA)
     assert np.all(np.diff(xi) > 0) and eta[-1] == pytest.approx(0.999)
+
+
+HB_CASE = {"dp": 0.003, "rheology": "herschel_bulkley", "density": 1000.0, "yield_stress": 20.0,
+           "consistency": 10.0, "index": 0.4, "max_viscosity": 100.0, "shifting": "skillen"}
+
+
+def test_conveyor_case_for_a_yield_stress_fluid():
+    from solver.conveyor import build_scene, case_from_dict, front_surface, initial_toe
+    from solver.scene import SceneError
+    c = case_from_dict(HB_CASE)
+    fluid = HBFluid(rho=1000.0, tau_y=20.0, K=10.0, n=0.4)
+    assert c.h_n == pytest.approx(normal_depth(fluid, U_B, G, THETA))
+    scene = build_scene(c)
+    assert scene.fluid.rheology == "herschel_bulkley" and scene.fluid.viscosity is None
+    # the lubrication start keeps the area of a block of fluid_length h_n at depth h_n
+    pts = np.array(front_surface(c))
+    area = float(np.sum(np.diff(pts[:, 0]) * 0.5 * (pts[1:, 1] + pts[:-1, 1])))
+    assert area == pytest.approx(c.fluid_length * c.h_n ** 2, rel=2e-3)
+    assert initial_toe(c) > c.fluid_length * c.h_n
+    with pytest.raises(SceneError, match="start_velocity"):
+        case_from_dict({**HB_CASE, "start_velocity": "lubrication"})
+
+
+def test_reference_for_a_yield_stress_fluid():
+    """The study's reference: Newtonian cases get SPEC section 5 unchanged; a HB case the
+    film at each station's depth, with zero lab-frame flux (depth-mean belt-frame u* = 1)."""
+    from solver.conveyor import case_from_dict
+    from study.reference import theory, theory_for_case
+    x, st, z = np.array([0.0, 1.0, 5.0]), [0.76, 1.5, 9.7], np.linspace(0, 1.3, 261)
+    newt = case_from_dict({"dp": 0.003})
+    a, b = theory_for_case(newt, x, st, z), theory(x, st, z, newt.slope_deg)
+    assert np.allclose(a["velocity"].values, b["velocity"].values, equal_nan=True)
+    ref = theory_for_case(case_from_dict(HB_CASE), x, st, z)
+    for k, s in enumerate(st):
+        eta = float(ref["station_depth"][k])
+        u = ref["velocity"].values[k]
+        inside = np.isfinite(u)
+        mean = np.trapezoid(u[inside], z[inside]) / eta
+        assert mean == pytest.approx(1.0, rel=0.02), s  # the z grid resolves the plug to 0.005 h_n

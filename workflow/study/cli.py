@@ -33,11 +33,11 @@ def cmd_case_file(a):
 def _reference(cfg):
     import numpy as np
     from .config import solver_case
-    from .reference import read_surface_csv, read_velocity_csv, theory
+    from .reference import read_surface_csv, read_velocity_csv, theory_for_case
     lo, hi = cfg["metrics"]["free_surface_x_star"]
     x = np.round(np.arange(lo, hi + 1e-9, 0.1), 10)
     z = np.round(np.arange(0.0, 1.3 + 1e-9, 0.025), 10)
-    ref = theory(x, cfg["metrics"]["stations"], z, solver_case(cfg).slope_deg)
+    ref = theory_for_case(solver_case(cfg), x, cfg["metrics"]["stations"], z)
     m = cfg["reference"]["measured"]
     measured = {"surface": read_surface_csv(m["free_surface"]) if m.get("free_surface") else None,
                 "velocity": {float(k): read_velocity_csv(v) for k, v in (m.get("velocity") or {}).items()}}
@@ -80,8 +80,12 @@ def cmd_reduce(a):
 
 
 def _figure_settings(cfg, ds):
+    import numpy as np
     from .figures import Settings
-    return Settings(profile_ch=float(cfg["figures"]["profile_ch"]), slope_deg=float(ds.attrs["slope_deg"]))
+    from .config import solver_case
+    from .reference import theory_for_case
+    profiles = theory_for_case(solver_case(cfg), np.array([0.0]), ds["station"].values, ds["z_star"].values)
+    return Settings(profile_ch=float(cfg["figures"]["profile_ch"]), theory=profiles)
 
 
 def cmd_figures(a):

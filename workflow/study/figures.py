@@ -13,7 +13,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
-from .reference import theory  # noqa: E402
 
 # Okabe-Ito palette
 COLOURS = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442", "#000000"]
@@ -26,7 +25,7 @@ STYLE = {"figure.dpi": 100, "axes.grid": True, "grid.alpha": 0.3, "font.size": 1
 class Settings:
     """What a figure takes beyond the campaign dataset."""
     profile_ch: float  # Ch of the single-Ch figures (nearest in the grid)
-    slope_deg: float  # the case's slope, for the theory curves
+    theory: xr.Dataset  # the reference velocity profiles at the stations (study.reference)
 
 
 @dataclass(frozen=True)
@@ -114,10 +113,9 @@ HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over t
           "of a run that did not reach steady state (read them as indicative only).")
 
 
-def fig_velocity_profiles(ds, ch, slope_deg):
+def fig_velocity_profiles(ds, ch, ref):
     ch = float(ds["ch"].sel(ch=ch, method="nearest"))
     st = ds["station"].values
-    ref = theory(np.array([0.0]), st, ds["z_star"].values, slope_deg)
     shs = list(ds["shifting"].values)
     fig, axs = plt.subplots(len(shs), st.size, figsize=(3.4 * st.size, 3.3 * len(shs)), squeeze=False, sharex=True)
     for i, sh in enumerate(shs):
@@ -292,7 +290,7 @@ FIGURES = (
                "Ch = {ch:g} (or the grid's nearest) and every dp, against lubrication theory "
                "(black). The paper found the profiles well reproduced away from the toe, with "
                "the largest deviations at x* = 0.76 where the theory itself is approximate.",
-               lambda ds, st: fig_velocity_profiles(ds, st.profile_ch, st.slope_deg)),
+               lambda ds, st: fig_velocity_profiles(ds, st.profile_ch, st.theory)),
     FigureSpec("fig06_zeta_u", "Fig. 6 - velocity-profile errors",
                "RMS velocity-profile error zeta_u,j at each station against dp for each Ch. The "
                "paper found the errors largest near the toe (x* = 0.76) and smallest in the "

@@ -29,6 +29,34 @@ def theory(x_star: np.ndarray, stations, z_star: np.ndarray, slope_deg: float) -
         attrs={"source": "lubrication theory (SPEC section 5)"})
 
 
+def theory_for_case(case, x_star, stations, z_star) -> xr.Dataset:
+    """``theory`` for a solver case (solver.conveyor.ConveyorCase) of either rheology. For a
+    Herschel-Bulkley fluid: the front of ``solver.viscoplastic.front_profile`` and, at each
+    station's depth h, the belt-frame film profile u(z) / u_b under its driving slope S(h)."""
+    if case.newtonian:
+        return theory(x_star, stations, z_star, case.slope_deg)
+    from solver import viscoplastic
+    xs, eta_tab = case.front_shape()
+    x = np.asarray(x_star, dtype=float)
+    st = np.asarray(stations, dtype=float)
+    zs = np.asarray(z_star, dtype=float)
+    eta = np.interp(x, xs, eta_tab)
+    eta_st = np.interp(st, xs, eta_tab)
+    hn, u_b, g, fluid = case.h_n, case.belt.speed, case.gravity, case.hb_fluid
+    u = np.full((st.size, zs.size), np.nan)
+    for k, e in enumerate(eta_st):
+        h = e * hn
+        S = viscoplastic.driving_slope(fluid, h, u_b, g)
+        inside = zs <= e + 1e-12
+        u[k, inside] = fluid.film(zs[inside] * hn, h, S, g) / u_b
+    return xr.Dataset(
+        {"surface": ("x_star", eta, {"units": "1", "long_name": "theory free surface h/h_n"}),
+         "station_depth": ("station", eta_st, {"units": "1", "long_name": "theory depth h/h_n at the station"}),
+         "velocity": (("station", "z_star"), u, {"units": "1", "long_name": "theory u* (belt frame)"})},
+        coords={"x_star": x, "station": st, "z_star": zs},
+        attrs={"source": "Herschel-Bulkley lubrication theory (solver/viscoplastic.py)"})
+
+
 def read_surface_csv(path) -> xr.DataArray:
     """Measured free surface: CSV with columns x_star, z_star."""
     df = _read(path, ("x_star", "z_star"))
