@@ -21,7 +21,7 @@ import numpy as np
 
 from .cells import cell_of, neighbour_cell
 from .forces import FASTMATH
-from .kernel import alpha_2d, grad_coefficient, grad_factor, w_value
+from .kernel import alpha_2d, grad_coefficient, grad_factor, kernel, w_value
 
 DET_MIN = 1.0e-3  # on the matrix made dimensionless with h
 
@@ -84,9 +84,7 @@ def lattice_number_density(ch: float) -> float:
     """sum_j dp^2 W(r_j) over a full square lattice around one of its nodes, h = ch dp."""
     m = int(math.ceil(2.0 * ch)) + 1
     i = np.arange(-m, m + 1, dtype=float)
-    r = np.hypot(*np.meshgrid(i, i)).ravel() / ch  # q = r / h
-    r = r[r < 2.0]
-    return float((7.0 / (4.0 * math.pi * ch * ch) * (1 - r / 2) ** 4 * (2 * r + 1)).sum())
+    return float(kernel(np.hypot(*np.meshgrid(i, i)), ch).sum())  # lengths in dp
 
 
 @functools.cache
