@@ -30,6 +30,7 @@ _SNAP_META = {
     "u": ("m s-1", "velocity along x"), "w": ("m s-1", "velocity along z"),
     "rho": ("kg m-3", "density"), "p": ("Pa", "pressure"),
     "kind": ("1", "0 fluid, 1 boundary"),
+    "mu": ("Pa s", "effective viscosity (Herschel-Bulkley; max_viscosity where unyielded)"),
 }
 
 
@@ -50,6 +51,8 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         data[k] = xr.Variable(("time",), np.asarray(v), {"units": units, "long_name": long})
     if res.snaps:
         for k, (units, long) in _SNAP_META.items():
+            if k not in res.snaps[0]:
+                continue
             arr = np.stack([s[k] for s in res.snaps])
             data[k] = xr.Variable(("snapshot", "particle"), arr, {"units": units, "long_name": long})
     coords = {

@@ -55,7 +55,8 @@ def test_report_has_every_section(campaign):
                     "Provenance"):
         assert f"<h2>{section}</h2>" in html
     assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
-    assert html.count("data:image/png;base64,") == 11  # Figs. 2-12
+    from study.figures import FIGURES
+    assert html.count("data:image/png;base64,") == len(FIGURES) == 12  # Figs. 2-13
     # the forced divergence is counted and named in the stability section and map
     assert "1 diverged, 1 of them stopped by a named detector (1 density deviation)" in html
     assert "http://" not in html and "https://" not in html  # opens offline

@@ -154,6 +154,33 @@ def fig_front_particles(ds, ch):
     return fig
 
 
+def fig_plug_map(ds, ch):
+    """Yielded (vermillion) and unyielded (blue) fluid at the front, finest dp."""
+    ch = float(ds["ch"].sel(ch=ch, method="nearest"))
+    dp = ds["dp"].values[-1]
+    shs = list(ds["shifting"].values)
+    fig, axs = plt.subplots(len(shs), 1, figsize=(8, 2.4 * len(shs)), squeeze=False, sharex=True)
+    for ax, sh in zip(axs[:, 0], shs):
+        x = ds["front_x"].sel(dp=dp, ch=ch, shifting=sh).values
+        z = ds["front_z"].sel(dp=dp, ch=ch, shifting=sh).values
+        y = ds["front_yielded"].sel(dp=dp, ch=ch, shifting=sh).values if "front_yielded" in ds else x * np.nan
+        ok = np.isfinite(x) & np.isfinite(y)
+        if ok.any():
+            ax.scatter(x[ok & (y > 0.5)], z[ok & (y > 0.5)], s=4, color=COLOURS[3], label="yielded")
+            ax.scatter(x[ok & (y < 0.5)], z[ok & (y < 0.5)], s=4, color=COLOURS[0], label="unyielded (plug)")
+            ax.legend(fontsize=7, loc="upper left")
+            ax.set_aspect("equal")
+        else:
+            ax.text(0.5, 0.5, "no yield stress in this campaign (or no final state)",
+                    transform=ax.transAxes, ha="center", va="center", color="0.4")
+        ax.set_title(f"{sh}, dp = {dp * 1000:g} mm, Ch = {ch:g}")
+        ax.set_ylabel("z / h_n")
+        ax.invert_xaxis()
+    axs[-1, 0].set_xlabel("x* upslope from the toe")
+    fig.tight_layout()
+    return fig
+
+
 def fig_shifting_comparison(ds, var, ch, station_panels=False):
     ch = float(ds["ch"].sel(ch=ch, method="nearest"))
     sub = ds.sel(ch=ch)
@@ -329,6 +356,12 @@ FIGURES = (
                "Not in the paper: it shows where explicit SPH breaks on this flow and how close "
                "the survivors came.",
                lambda ds, st: fig_stability_map(ds)),
+    FigureSpec("fig13_plug_map", "Where the plug is",
+               "For a Herschel-Bulkley fluid: the final fluid particles within 3 h_n of the toe "
+               "at the finest dp and Ch = {ch:g}, yielded (viscosity below the cap max_viscosity) "
+               "or unyielded (at the cap: the plug). Not in the paper; empty for a Newtonian "
+               "campaign.",
+               lambda ds, st: fig_plug_map(ds, st.profile_ch)),
 )
 FIGURE_NAMES = tuple(f.name for f in FIGURES)
 
