@@ -228,6 +228,8 @@ class FrontMonitor:
         depth_far = ds.surface_elevation.sel(x_star=self.stations[far], method="nearest").values / hn
         nu_ratio, slip = film_fit.fit_series(self.z_star, ds.velocity_star.values[:, far, :], depth_far,
                                              2.0 * c.ch * c.dp / hn)
+        if not c.newtonian:  # the fit assumes the Newtonian film: meaningless here
+            nu_ratio, slip = np.full_like(nu_ratio, np.nan), np.full_like(slip, np.nan)
         ds["film_viscosity_ratio"] = (("time",), nu_ratio, {
             "units": "1",
             "long_name": f"nu_eff / nu from the curvature of the u* profile at x* = {self.stations[far]:g}"})
