@@ -223,18 +223,15 @@ def initial_toe(c: ConveyorCase, warm=None) -> float:
     return (c.fluid_length + deficit) * hn
 
 
-def front_surface(c: ConveyorCase, n: int = 600) -> list[list[float]]:
+def front_surface(c: ConveyorCase) -> list[list[float]]:
     """Points of the lubrication front surface from the wall (x = 0) to the toe, with the
     area of a block of length fluid_length h_n at depth h_n."""
     hn, x_toe = c.h_n, initial_toe(c)
+    xs, eta = c.front_shape()
+    xi = xs * hn
     if c.newtonian:
-        eta = np.concatenate([np.linspace(0.0, 0.99, n // 2, endpoint=False),
-                              1 - np.geomspace(0.01, 1e-9, n // 2)])
-        xi = lubrication.xi_star(eta, c.theta) * hn
         eta_wall = lubrication.front_eta(x_toe / hn, c.theta)
     else:
-        xs, eta = c.front_shape()
-        xi = xs * hn
         eta_wall = float(np.interp(x_toe / hn, xs, eta))
     x = x_toe - xi
     keep = x > 0

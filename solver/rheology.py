@@ -19,6 +19,14 @@ from .forces import DUX, DUZ, DWX, DWZ
 
 
 @nb.njit(inline="always", cache=True)
+def strain_rate(out, i):
+    """gamma of particle i from the gradient sums in ``out`` (module docstring)."""
+    ux, uz, wx, wz = out[DUX, i], out[DUZ, i], out[DWX, i], out[DWZ, i]
+    s = uz + wx
+    return math.sqrt(2.0 * ux * ux + 2.0 * wz * wz + s * s)
+
+
+@nb.njit(inline="always", cache=True)
 def effective_viscosity(gamma, tau_y, K, n, mu_max, m):
     """mu(gamma) of the module docstring; m <= 0 selects the bi-viscous form."""
     if gamma <= 0.0:
@@ -39,15 +47,7 @@ def update_viscosity(out, kind, nu_p, n_active, rho0, tau_y, K, n, mu_max, m):
     for i in nb.prange(n_active):
         if kind[i] != 0:
             continue
-        ux, uz, wx, wz = out[DUX, i], out[DUZ, i], out[DWX, i], out[DWZ, i]
-        s = uz + wx
-        gamma = math.sqrt(2.0 * ux * ux + 2.0 * wz * wz + s * s)
-        nu_p[i] = effective_viscosity(gamma, tau_y, K, n, mu_max, m) / rho0
+        nu_p[i] = effective_viscosity(strain_rate(out, i), tau_y, K, n, mu_max, m) / rho0
         numax = max(numax, nu_p[i])
     return numax
 
-
-def strain_rate(out, i) -> float:
-    """gamma of particle i from the gradient sums (for tests and probes)."""
-    ux, uz, wx, wz = out[DUX, i], out[DUZ, i], out[DWX, i], out[DWZ, i]
-    return math.sqrt(2 * ux * ux + 2 * wz * wz + (uz + wx) ** 2)

@@ -15,6 +15,12 @@ from solver.simulation import Simulation
 from tests.conftest import example_scene
 
 L_CHANNEL = 1.0e-3
+# (measured, bound) at t = 0.6 s: the L2 error still falls slowly (2.10 % at 1.2 s), so the
+# issue's 2 % is not met at the test's end time; the bound is the measurement plus 20 %.
+HB_FILM_L2 = (0.0251, 0.030)
+# the computed plug is 6 % thinner than the exact 7.73 mm (5.6 % at 1.2 s): measured value
+# and the allowed deviation from it
+HB_FILM_YIELD = (-0.060, 0.025)
 
 
 def steady_state(name: str, **changes):
@@ -87,22 +93,16 @@ def test_herschel_bulkley_film():
     assert abs(plug_error - HB_FILM_YIELD[0]) < HB_FILM_YIELD[1], plug_error
 
 
-# (measured, bound) at t = 0.6 s: the L2 error still falls slowly (2.10 % at 1.2 s), so the
-# issue's 2 % is not met at the test's end time; the bound is the measurement plus 20 %.
-HB_FILM_L2 = (0.0251, 0.030)
-# the computed plug is 6 % thinner than the exact 7.73 mm (5.6 % at 1.2 s): measured value
-# and the allowed deviation from it
-HB_FILM_YIELD = (-0.060, 0.025)
 
 
 def test_rheology_keys_are_validated():
+    from solver.scene import scene_from_dict
     base = example_scene("bingham").to_dict()
     for change, key in (({"rheology": "bingham"}, "fluid.rheology"),
                         ({"max_viscosity": None}, "fluid.max_viscosity"),
                         ({"consistency": -1.0}, "fluid.consistency"),
                         ({"viscosity": 1.0}, "fluid.viscosity")):
         d = {**base, "fluid": {**base["fluid"], **change}}
-        from solver.scene import scene_from_dict
         with pytest.raises(SceneError, match=key.replace(".", r"\.")):
             scene_from_dict(d)
 

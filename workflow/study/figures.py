@@ -135,35 +135,36 @@ def fig_velocity_profiles(ds, ch, ref):
     return fig
 
 
-def fig_front_particles(ds, ch):
+def _front_panels(ds, ch, draw):
+    """One panel per shifting method of the final particles within 3 h_n of the toe at the
+    finest dp and the Ch nearest ``ch``; ``draw(ax, sh, x, z)`` fills each panel."""
     ch = float(ds["ch"].sel(ch=ch, method="nearest"))
     dp = ds["dp"].values[-1]
     shs = list(ds["shifting"].values)
     fig, axs = plt.subplots(len(shs), 1, figsize=(8, 2.4 * len(shs)), squeeze=False, sharex=True)
     for ax, sh in zip(axs[:, 0], shs):
-        x = ds["front_x"].sel(dp=dp, ch=ch, shifting=sh).values
-        z = ds["front_z"].sel(dp=dp, ch=ch, shifting=sh).values
-        ok = np.isfinite(x)
-        ax.scatter(x[ok], z[ok], s=4, color=COLOURS[0])
+        sel = dict(dp=dp, ch=ch, shifting=sh)
+        draw(ax, sel, ds["front_x"].sel(**sel).values, ds["front_z"].sel(**sel).values)
         ax.set_title(f"{sh}, dp = {dp * 1000:g} mm, Ch = {ch:g}")
         ax.set_ylabel("z / h_n")
-        ax.set_aspect("equal")
         ax.invert_xaxis()
     axs[-1, 0].set_xlabel("x* upslope from the toe")
     fig.tight_layout()
     return fig
 
 
+def fig_front_particles(ds, ch):
+    def draw(ax, sel, x, z):
+        ok = np.isfinite(x)
+        ax.scatter(x[ok], z[ok], s=4, color=COLOURS[0])
+        ax.set_aspect("equal")
+    return _front_panels(ds, ch, draw)
+
+
 def fig_plug_map(ds, ch):
     """Yielded (vermillion) and unyielded (blue) fluid at the front, finest dp."""
-    ch = float(ds["ch"].sel(ch=ch, method="nearest"))
-    dp = ds["dp"].values[-1]
-    shs = list(ds["shifting"].values)
-    fig, axs = plt.subplots(len(shs), 1, figsize=(8, 2.4 * len(shs)), squeeze=False, sharex=True)
-    for ax, sh in zip(axs[:, 0], shs):
-        x = ds["front_x"].sel(dp=dp, ch=ch, shifting=sh).values
-        z = ds["front_z"].sel(dp=dp, ch=ch, shifting=sh).values
-        y = ds["front_yielded"].sel(dp=dp, ch=ch, shifting=sh).values if "front_yielded" in ds else x * np.nan
+    def draw(ax, sel, x, z):
+        y = ds["front_yielded"].sel(**sel).values if "front_yielded" in ds else x * np.nan
         ok = np.isfinite(x) & np.isfinite(y)
         if ok.any():
             ax.scatter(x[ok & (y > 0.5)], z[ok & (y > 0.5)], s=4, color=COLOURS[3], label="yielded")
@@ -173,12 +174,7 @@ def fig_plug_map(ds, ch):
         else:
             ax.text(0.5, 0.5, "no yield stress in this campaign (or no final state)",
                     transform=ax.transAxes, ha="center", va="center", color="0.4")
-        ax.set_title(f"{sh}, dp = {dp * 1000:g} mm, Ch = {ch:g}")
-        ax.set_ylabel("z / h_n")
-        ax.invert_xaxis()
-    axs[-1, 0].set_xlabel("x* upslope from the toe")
-    fig.tight_layout()
-    return fig
+    return _front_panels(ds, ch, draw)
 
 
 def fig_shifting_comparison(ds, var, ch, station_panels=False):
