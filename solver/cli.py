@@ -74,8 +74,13 @@ def _set_threads(threads) -> bool:
 
 
 def apply_overrides(data: dict, items) -> dict:
-    """--set a.b=VALUE: VALUE is read as YAML (numbers, lists, null)."""
+    """--set a.b=VALUE: VALUE is read as YAML (numbers, lists, null). A named case changed by
+    overrides is renamed to say so, 'NAME [a.b=VALUE, ...]', unless ``name`` is set too."""
     import yaml
+    items = list(items)
+    keys = [item.partition("=")[0] for item in items]
+    if items and "name" in data and "name" not in keys:
+        data["name"] = f"{data['name']} [{', '.join(items)}]"
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key:
@@ -98,6 +103,8 @@ def _front(args) -> int:
     except (SceneError, OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    if args.set and not args.quiet:
+        print(f"case: {case.name}", file=sys.stderr)
     if not _set_threads(args.threads):
         return 2
     from .front import run_front

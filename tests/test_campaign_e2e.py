@@ -51,15 +51,24 @@ def test_campaign_dataset(campaign):
 
 def test_report_has_every_section(campaign):
     html = (campaign / "reports" / "report.html").read_text()
-    for section in ("Summary", "Configuration", "Cases", "Convergence", "Cost", "Stability", "Figures",
-                    "Provenance"):
-        assert f"<h2>{section}</h2>" in html
+    sections = ("Verdict", "Accuracy and cost", "Summary", "Figures", "Cases", "Convergence",
+                "Stability", "Configuration", "Provenance")
+    assert [html.index(f"<h2>{s}</h2>") for s in sections] == sorted(html.index(f"<h2>{s}</h2>") for s in sections)
     assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
     from study.figures import FIGURES
     assert html.count("data:image/png;base64,") == len(FIGURES) == 12  # Figs. 2-13
     # the forced divergence is counted and named in the stability section and map
     assert "1 diverged, 1 of them stopped by a named detector (1 density deviation)" in html
     assert "http://" not in html and "https://" not in html  # opens offline
+
+
+def test_report_in_a_real_browser(campaign):
+    from study.browser import check_report, find_browser
+    if find_browser() is None:
+        pytest.skip("no Chromium (Debian: apt-get install chromium); .ci/run installs it")
+    r = check_report(campaign / "reports" / "report.html", screenshot=campaign / "first_screen.png")
+    assert r.ok, (r.broken, r.external)
+    assert len(r.images) == 12 and r.title == "sph-surge campaign report"
 
 
 def test_figure_settings_do_not_rerun_simulations(campaign, tmp_path):

@@ -66,3 +66,17 @@ def test_write_atomic_keeps_old_file_on_failure(tmp_path):
         pass
     assert xr.open_dataset(path)["a"].values.tolist() == [1.0]
     assert [p.name for p in tmp_path.iterdir()] == ["r.nc"]
+
+
+def test_overrides_rename_a_named_case():
+    """--set shifting=skillen on a case named '...-lind' must not leave the lind title."""
+    from solver.cli import apply_overrides
+    from solver.conveyor import case_from_dict
+    data = apply_overrides({"name": "paper-dp1-ch1.8-lind", "dp": 1e-3, "shifting": "lind"},
+                           ["shifting=skillen", "steady.max_time=5"])
+    case = case_from_dict(data)
+    assert case.shifting == "skillen" and case.steady.max_time == 5.0
+    assert case.name == "paper-dp1-ch1.8-lind [shifting=skillen, steady.max_time=5]"
+    named = apply_overrides({"name": "a", "dp": 1e-3}, ["shifting=skillen", "name=b"])
+    assert named["name"] == "b"  # an explicit name wins
+    assert apply_overrides({"name": "a", "dp": 1e-3}, [])["name"] == "a"

@@ -32,6 +32,7 @@ rule run_case:
         "results/logs/run_{case}.log",
     params:
         solver=SOLVER_HASH,
+    priority: run_priority
     threads: RES["threads"]
     resources:
         runtime=RES["runtime_min"],

@@ -23,11 +23,11 @@ FRONT_XSTAR = 3.0  # particles within this x* of the toe are kept for the front 
 
 def _front_particles(run: xr.Dataset, max_n: int):
     """Fluid particle positions (x*, z*) within FRONT_XSTAR of the toe in the final snapshot,
-    and for a Herschel-Bulkley fluid whether each has yielded (1: mu below the cap
-    max_viscosity, 0: at the cap; NaN for a Newtonian fluid)."""
+    their lab-frame speed |u| / u_b, and for a Herschel-Bulkley fluid whether each has
+    yielded (1: mu below the cap max_viscosity, 0: at the cap; NaN for a Newtonian fluid)."""
     nan = np.full(max_n, np.nan)
     if "snapshot" not in run.dims or "toe_position" not in run or run.sizes.get("time", 0) == 0:
-        return nan, nan.copy(), nan.copy()
+        return nan, nan.copy(), nan.copy(), nan.copy()
     s = run.isel(snapshot=-1)
     hn = float(run.attrs["h_n_m"])
     toe = float(run["toe_position"].values[-1])
@@ -36,14 +36,15 @@ def _front_particles(run: xr.Dataset, max_n: int):
     zs = s["z"].values[f] / hn
     keep = (xs >= -0.5) & (xs <= FRONT_XSTAR)
     xs, zs = xs[keep][:max_n], zs[keep][:max_n]
-    px, pz, py = np.full(max_n, np.nan), np.full(max_n, np.nan), np.full(max_n, np.nan)
+    px, pz, pv, py = (np.full(max_n, np.nan) for _ in range(4))
     px[:xs.size], pz[:zs.size] = xs, zs
+    case = yaml.safe_load(run.attrs["case_yaml"])
+    if "u" in s and "w" in s:
+        pv[:xs.size] = np.hypot(s["u"].values[f], s["w"].values[f])[keep][:max_n] / case["belt"]["speed"]
     if "mu" in s:
-        import yaml
-        mu_max = float(yaml.safe_load(run.attrs["case_yaml"])["max_viscosity"])
         mu = s["mu"].values[f][keep][:max_n]
-        py[:mu.size] = (mu < 0.999 * mu_max).astype(float)
-    return px, pz, py
+        py[:mu.size] = (mu < 0.999 * float(case["max_viscosity"])).astype(float)
+    return px, pz, pv, py
 
 
 def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
@@ -68,6 +69,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     data["mean_velocity"] = arr(stations.size, z_star.size)
     data["front_x"] = arr(front_particles)
     data["front_z"] = arr(front_particles)
+    data["front_speed"] = arr(front_particles)
     data["front_yielded"] = arr(front_particles)
     steady = np.zeros(shape)
     status = np.full(shape, "missing", dtype=object)
@@ -89,8 +91,8 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
             data["mean_surface"][ix] = run["mean_surface_elevation"].values / run.attrs["h_n_m"]
             data["mean_velocity"][ix] = run["mean_velocity_star"].values
         if run.attrs["status"] != "diverged":  # a diverged run keeps no final state
-            data["front_x"][ix], data["front_z"][ix], data["front_yielded"][ix] = _front_particles(
-                run, front_particles)
+            (data["front_x"][ix], data["front_z"][ix], data["front_speed"][ix],
+             data["front_yielded"][ix]) = _front_particles(run, front_particles)
         status[ix], reason[ix], case_ids[ix] = run.attrs["status"], run.attrs["reason"], c.id
         steady[ix] = float(m["steady"])
 
@@ -104,6 +106,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
          "mean_velocity": (dims + ("station", "z_star"), data["mean_velocity"]),
          "front_x": (dims + ("front_particle",), data["front_x"]),
          "front_z": (dims + ("front_particle",), data["front_z"]),
+         "front_speed": (dims + ("front_particle",), data["front_speed"]),
          "front_yielded": (dims + ("front_particle",), data["front_yielded"]),
          "steady": (dims, steady, {"units": "1", "long_name": "1: metrics from a steady window"}),
          "status": (dims, status.astype(str)),
@@ -124,6 +127,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["mean_velocity"].attrs.update(units="1", long_name="steady u* (belt frame)")
     ds["front_x"].attrs.update(units="1", long_name="final fluid particles near the front, x* upslope of toe")
     ds["front_z"].attrs.update(units="1", long_name="final fluid particles near the front, z/h_n")
+    ds["front_speed"].attrs.update(units="1", long_name="final speed near the front, lab frame, |u| / u_b")
     ds["front_yielded"].attrs.update(
         units="1", long_name="1: yielded (viscosity below the cap), 0: unyielded; NaN: newtonian")
 

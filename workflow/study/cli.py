@@ -119,6 +119,20 @@ def cmd_report(a):
     print(a.output)
 
 
+def cmd_check_report(a):
+    """Headless Chromium: every image decoded, no request outside the file, a screenshot."""
+    from .browser import check_report
+    r = check_report(a.report, screenshot=a.screenshot, width=a.width, height=a.height)
+    print(f"{a.report}: {len(r.images)} images, {len(r.broken)} not decoded, "
+          f"{len(r.external)} external requests" + (f"; screenshot {a.screenshot}" if a.screenshot else ""))
+    for alt in r.broken:
+        print(f"  not decoded: {alt}")
+    for url in r.external:
+        print(f"  external request: {url}")
+    if not r.ok:
+        raise SystemExit(1)
+
+
 def _write_text(path, text):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -150,6 +164,10 @@ def main(argv=None) -> int:
     p.add_argument("config"); p.add_argument("campaign"); p.add_argument("--figures", required=True)  # noqa: E702
     p.add_argument("-o", "--output", required=True)
     p.set_defaults(fn=cmd_report)
+    p = sub.add_parser("check-report", help="open the report in headless Chromium: images, requests, screenshot")
+    p.add_argument("report"); p.add_argument("--screenshot")  # noqa: E702
+    p.add_argument("--width", type=int, default=1280); p.add_argument("--height", type=int, default=900)  # noqa: E702
+    p.set_defaults(fn=cmd_check_report)
     a = ap.parse_args(argv)
     from .config import ConfigError
     try:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 
 import yaml
@@ -33,14 +34,32 @@ def _path(err) -> str:
     return p or "(top level)"
 
 
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def coerce_numbers(value, schema: dict):
+    """``value`` with every string that the schema types as a number read as one: YAML 1.1
+    (PyYAML, Snakemake's loader) reads ``3e-3`` as a string, YAML 1.2 and users as 3e-3."""
+    types = schema.get("type")
+    types = [types] if isinstance(types, str) else (types or [])
+    if isinstance(value, str) and "number" in types and _NUMBER.fullmatch(value.strip()):
+        return float(value)
+    if isinstance(value, dict):
+        props = schema.get("properties", {})
+        return {k: coerce_numbers(v, props[k]) if k in props else v for k, v in value.items()}
+    if isinstance(value, list) and isinstance(schema.get("items"), dict):
+        return [coerce_numbers(v, schema["items"]) for v in value]
+    return value
+
+
 def validate(config: dict) -> dict:
     """Validate against the JSON schema (filling defaults) and check what a schema cannot.
 
     Returns the config with defaults; raises ConfigError naming the key.
     """
     import jsonschema
-    cfg = copy.deepcopy(config)
     schema = load_schema()
+    cfg = coerce_numbers(copy.deepcopy(config), schema)
     validator_cls = jsonschema.validators.validator_for(schema)
 
     def set_defaults(validator, properties, instance, schema):  # fill defaults while validating

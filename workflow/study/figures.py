@@ -50,40 +50,76 @@ def _dp_mm(ds):
     return ds["dp"].values * 1000.0
 
 
-def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", invert_x: bool = True):
-    """Log axes when something was drawn (dp axes run coarse to fine, left to right);
-    otherwise say there is nothing to draw."""
+def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", invert_x: bool = True,
+              dp_ticks=None):
+    """Log axes when something was drawn (dp axes run coarse to fine, left to right, ticked
+    at the campaign's dp values in plain numbers); otherwise say there is nothing to draw."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
     if any_data:
         ax.set_xscale("log")
         ax.set_yscale("log")
         if invert_x:
             ax.invert_xaxis()
+        if dp_ticks is not None:
+            ax.xaxis.set_major_locator(FixedLocator(np.asarray(dp_ticks, dtype=float)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_major_formatter(FuncFormatter(_plain))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _plain(v, _) if _few_decades(ax) else ""))
     else:
         ax.text(0.5, 0.5, "no run gave this metric\n(diverged)", transform=ax.transAxes,
                 ha="center", va="center", color="0.4")
     ax.set_xlabel(xlabel)
 
 
-def _legend(axes, **kw):
-    """Legend on the first of ``axes`` that has labelled artists."""
+def _plain(v, _pos=None) -> str:
+    """A tick label without exponent notation: 0.003, 0.02, 1, 30."""
+    return f"{v:.4g}" if 1e-4 <= abs(v) < 1e5 else f"{v:.0e}"
+
+
+def _few_decades(ax) -> bool:
+    lo, hi = sorted(ax.get_ylim())
+    return lo > 0 and hi / lo < 12  # label minor ticks where a decade has no major one
+
+
+def _legend(axes, steadiness: bool = True, **kw):
+    """One entry per label, on the first of ``axes`` that has labelled artists; with
+    ``steadiness``, filled against hollow markers explained once."""
+    from matplotlib.lines import Line2D
     for ax in axes:
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(**kw)
+        handles, labels = ax.get_legend_handles_labels()
+        if handles:
+            seen = dict(zip(labels, handles))
+            if steadiness:
+                seen["steady window"] = Line2D([], [], ls="none", marker="o", color="0.35")
+                seen["final window, not steady"] = Line2D([], [], ls="none", marker="o", mfc="none",
+                                                          color="0.35")
+            ax.legend(list(seen.values()), list(seen.keys()), **kw)
             return
 
 
-def _points(ax, x, y, steady, k, label):
-    """Filled markers: steady window; hollow: final window of a run that was not steady."""
+def _points(ax, x, y, steady, k, label, band=None):
+    """Filled markers: steady window; hollow: final window of a run that was not steady.
+    One legend entry (``label``) per call; ``band``: a GCI error bar on the finest point."""
     ok = np.isfinite(y) & (y > 0)
     c, m = COLOURS[k % 8], MARKERS[k % 8]
     if ok.any():
         ax.plot(x[ok], y[ok], color=c, lw=1, alpha=0.6)
+        ax.plot([], [], color=c, lw=1, marker=m, label=label)  # the legend entry
         st = ok & (steady > 0)
         un = ok & ~(steady > 0)
-        ax.plot(x[st], y[st], ls="none", marker=m, color=c, label=label)
-        ax.plot(x[un], y[un], ls="none", marker=m, mfc="none", color=c,
-                label=None if st.any() else label)
+        ax.plot(x[st], y[st], ls="none", marker=m, color=c)
+        ax.plot(x[un], y[un], ls="none", marker=m, mfc="none", color=c)
+        if band is not None and np.isfinite(band):
+            i = np.argmin(np.where(ok, x, np.inf))
+            ax.errorbar(x[i], y[i], yerr=[[min(band, 0.95 * y[i])], [band]], color=c, capsize=3, lw=1)
     return bool(ok.any())
+
+
+def _gci_band(dp, y) -> float:
+    """Absolute GCI band of the finest value of a metric sequence (NaN unless monotone)."""
+    from .verdict import extrapolate
+    return extrapolate(dp, y).band
 
 
 def _error_vs_dp(ax, ds, var, shifting, label_ch=True, station=None):
@@ -93,8 +129,9 @@ def _error_vs_dp(ax, ds, var, shifting, label_ch=True, station=None):
         if station is not None:
             y = y.sel(station=station)
         steady = ds["steady"].sel(ch=ch, shifting=shifting).values
-        drawn |= _points(ax, _dp_mm(ds), y.values, steady, k, f"Ch = {ch:g}" if label_ch else None)
-    _log_axes(ax, drawn)
+        drawn |= _points(ax, _dp_mm(ds), y.values, steady, k, f"Ch = {ch:g}" if label_ch else None,
+                         band=_gci_band(ds["dp"].values, y.values))
+    _log_axes(ax, drawn, dp_ticks=_dp_mm(ds))
 
 
 def _metric_figure(ds, var, ylabel):
@@ -110,7 +147,9 @@ def _metric_figure(ds, var, ylabel):
 
 
 HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over the final window "
-          "of a run that did not reach steady state (read them as indicative only).")
+          "of a run that did not reach steady state (read them as indicative only). Error bars on "
+          "the finest dp: the GCI band of that value (Celik et al. 2008), where the three finest "
+          "dp converge monotonically.")
 
 
 def fig_velocity_profiles(ds, ch, ref):
@@ -147,18 +186,28 @@ def _front_panels(ds, ch, draw):
         draw(ax, sel, ds["front_x"].sel(**sel).values, ds["front_z"].sel(**sel).values)
         ax.set_title(f"{sh}, dp = {dp * 1000:g} mm, Ch = {ch:g}")
         ax.set_ylabel("z / h_n")
-        ax.invert_xaxis()
+    axs[0, 0].invert_xaxis()  # once: the panels share x; the toe on the right, as the flow runs
     axs[-1, 0].set_xlabel("x* upslope from the toe")
     fig.tight_layout()
     return fig
 
 
 def fig_front_particles(ds, ch):
+    """The final particles at the front coloured by their lab-frame speed |u| / u_b."""
+    speed = ds["front_speed"] if "front_speed" in ds else ds["front_x"] * np.nan
+    vmax = float(np.nanmax(speed.values)) if np.isfinite(speed.values).any() else 1.0
+    artists = []
+
     def draw(ax, sel, x, z):
+        v = speed.sel(**sel).values
         ok = np.isfinite(x)
-        ax.scatter(x[ok], z[ok], s=4, color=COLOURS[0])
+        artists.append(ax.scatter(x[ok], z[ok], s=4, c=np.nan_to_num(v[ok], nan=0.0), cmap="viridis",
+                                  vmin=0.0, vmax=vmax))
         ax.set_aspect("equal")
-    return _front_panels(ds, ch, draw)
+    fig = _front_panels(ds, ch, draw)
+    if artists:
+        fig.colorbar(artists[0], ax=fig.axes, label="|u| / u_b (lab frame)", shrink=0.8)
+    return fig
 
 
 def fig_plug_map(ds, ch):
@@ -188,12 +237,13 @@ def fig_shifting_comparison(ds, var, ch, station_panels=False):
             y = sub[var].sel(shifting=sh)
             if s is not None:
                 y = y.sel(station=s)
-            drawn |= _points(ax, _dp_mm(sub), y.values, sub["steady"].sel(shifting=sh).values, k, sh)
-        _log_axes(ax, drawn)
+            drawn |= _points(ax, _dp_mm(sub), y.values, sub["steady"].sel(shifting=sh).values, k, sh,
+                             band=_gci_band(sub["dp"].values, y.values))
+        _log_axes(ax, drawn, dp_ticks=_dp_mm(sub))
         ax.set_ylabel(var)
         if s is not None:
             ax.set_title(f"x* = {s:g}")
-    axs[0][-1].legend()
+    _legend(axs[0][::-1], fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -321,7 +371,8 @@ FIGURES = (
                lambda ds, st: fig_zeta_u(ds), hollow=True),
     FigureSpec("fig07_front_particles", "Fig. 7 - particles at the front",
                "Final fluid particle distribution within 3 h_n of the toe for each shifting "
-               "method at the finest dp and Ch = {ch:g} (or the grid's nearest). The paper found "
+               "method at the finest dp and Ch = {ch:g} (or the grid's nearest), coloured by the "
+               "particle speed in the lab frame, |u| / u_b (the belt moves at 1). The paper found "
                "the Lind shifting smoother and less ordered near the free surface than the "
                "Skillen (DualSPHysics release) shifting.",
                lambda ds, st: fig_front_particles(ds, st.profile_ch)),

@@ -1,4 +1,5 @@
-"""Self-contained HTML report: configuration, case table, figures with captions, provenance."""
+"""Self-contained HTML report: the verdict on the paper's conclusions first, then accuracy and
+cost, figures with captions, the case table, convergence, stability, configuration, provenance."""
 from __future__ import annotations
 
 import base64
@@ -20,6 +21,9 @@ table{border-collapse:collapse;font-size:.85em}td,th{border:1px solid #ddd;paddi
 th{background:#f3f3f3}td.l,th.l{text-align:left}tr.diverged td{background:#fde2e1}tr.not_steady td{background:#fff4d6}
 figure{margin:1.5em 0}figcaption{font-size:.9em;color:#444;max-width:900px}img{max-width:100%}
 pre{background:#f7f7f7;padding:.8em;overflow-x:auto;font-size:.85em}
+nav ul{display:flex;flex-wrap:wrap;gap:.3em 1.2em;list-style:none;padding:0;margin:0}
+p.lead{font-size:1.05em}td.ok{background:#d9f2e6}td.warn{background:#fff4d6}td.bad{background:#fde2e1}
+table.verdict td{vertical-align:top}table.verdict td.l{max-width:640px}
 """
 
 
@@ -97,24 +101,68 @@ def convergence_table(ds: xr.Dataset) -> str:
             f"<table>{head}{''.join(rows)}</table>")
 
 
-def cheapest_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
-    """For each metric and threshold, the cheapest case (wall time) whose error meets it."""
-    from .pareto import cheapest_meeting
-    st = ds["station"].values
-    metrics = [(k, ds[f"case_{k}"].values) for k in ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs")]
-    metrics += [(f"zeta_u x*={s:g}", ds["case_zeta_u"].values[:, j]) for j, s in enumerate(st)]
-    cost = ds["case_wall_time"].values
-    steady = ds["case_steady"].values > 0
+VERDICT_CLASS = {"reproduced": "ok", "not reproduced": "warn", "contradicted": "bad", "no data": "warn"}
+
+
+def verdict_table(ds: xr.Dataset) -> str:
+    """One row per conclusion of the paper: our numbers and the verdict (study.verdict)."""
+    from .verdict import PAPER_FINEST_DP, verdicts
     rows = []
-    for name, err in metrics:
-        for thr in thresholds:
-            i = cheapest_meeting(np.where(steady, cost, np.nan), err, thr)
-            case = "none" if i is None else f"{ds['case'].values[i]} ({cost[i]:.0f} s, {err[i]:.3g})"
-            rows.append(f'<tr><td class="l">{html.escape(name)}</td><td>{thr:g}</td>'
-                        f'<td class="l">{html.escape(case)}</td></tr>')
-    return ("<p>Cheapest steady case meeting each threshold (wall time, error).</p><table>"
-            "<tr><th class='l'>metric</th><th>threshold</th><th class='l'>cheapest case</th></tr>"
+    for v in verdicts(ds):
+        caveat = ""
+        if v.unsteady:
+            caveat = (f"<br><small><b>Rests on {len(v.unsteady)} of {len(v.cases)} runs that are not "
+                      f"steady</b> ({html.escape(', '.join(v.unsteady))}): indicative only.</small>")
+        rows.append(f'<tr><td class="l">{html.escape(v.claim)}</td>'
+                    f'<td class="l {VERDICT_CLASS[v.verdict]}"><b>{html.escape(v.verdict)}</b>'
+                    f'{"*" if v.unsteady else ""}</td>'
+                    f'<td class="l">{html.escape(v.evidence)}{caveat}</td></tr>')
+    finest = float(np.min(ds["dp"].values)) * 1000
+    return (f"<p>Each conclusion of the paper, judged on this campaign's own runs at its finest dp "
+            f"({finest:g} mm; the paper's finest is {PAPER_FINEST_DP * 1000:g} mm). "
+            "<b>reproduced</b>: our numbers show it; <b>contradicted</b>: they show the opposite "
+            "beyond their uncertainty (for a threshold: even the GCI extrapolation to dp &rarr; 0 "
+            "misses it); <b>not reproduced</b>: neither, at these resolutions. * : the verdict rests "
+            "on runs that are not steady.</p>"
+            "<table class='verdict'><tr><th class='l'>the paper's conclusion</th><th class='l'>verdict</th>"
+            "<th class='l'>evidence (metrics at the finest dp where the runs finished)</th></tr>"
             + "".join(rows) + "</table>")
+
+
+def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
+    """Per metric: the cheapest steady run under each threshold, and per shifting method at
+    the paper's Ch the GCI-extrapolated value, its band and the dp needed for 1 %."""
+    from .verdict import accuracy_rows
+    rows = accuracy_rows(ds, thresholds)
+    out, last = [], None
+    for r in rows:
+        first = r["metric"] != last
+        last = r["metric"]
+        cells = [f'<td class="l">{html.escape(r["metric"]) if first else ""}</td>']
+        for thr in thresholds:
+            c = r["cheapest"][thr]
+            txt = "none" if c is None else f"{c[0]} ({c[1]:.0f} s, {c[2]:.3g})"
+            cells.append(f'<td class="l">{html.escape(txt) if first else ""}</td>')
+        x = r["extrapolation"]
+        if x.status == "monotone":
+            lim = f"{_fmt(x.extrapolated)} &plusmn; {_fmt(x.band, 2)} (p = {x.order:.2g})"
+            need = ("never (limit above 1 %)" if not np.isfinite(x.dp_needed)
+                    else f"{x.dp_needed * 1000:.3g} mm")
+        else:
+            lim, need = html.escape(x.status), "&ndash;"
+        cells += [f'<td class="l">{html.escape(r["shifting"])}</td>', f"<td>{_fmt(x.finest)}</td>",
+                  f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
+        out.append("<tr>" + "".join(cells) + "</tr>")
+    ch = rows[0]["ch"] if rows else float("nan")
+    head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady run &le; {t:g}</th>"
+                                                     for t in thresholds)
+            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
+            "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
+    return ("<p>The cheapest steady run (wall time, error) meeting each threshold over the whole "
+            "grid; then, at the paper's Ch, the metric at the finest dp, its Richardson limit with "
+            "the GCI band of the finest value (Celik et al. 2008; only for monotone sequences over "
+            "the three finest dp) and the dp at which zeta = limit + C dp^p reaches 1 %.</p>"
+            f"<table>{head}{''.join(out)}</table>")
 
 
 def stability_section(ds: xr.Dataset) -> str:
@@ -194,16 +242,21 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th>'
                                     f'<td class="l">{html.escape(str(v))}</td></tr>'
                                     for k, v in prov.items()) + "</table>"
-    body = [("Summary", summary), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
-            ("Cases", case_table(ds)), ("Convergence", convergence_table(ds)),
-            ("Cost", cheapest_table(ds)), ("Stability", stability_section(ds)), *extra_sections,
-            ("Figures", "".join(figs)), ("Provenance", prov_html)]
+    body = [("Verdict", verdict_table(ds)), ("Accuracy and cost", accuracy_table(ds)),
+            ("Summary", summary), ("Figures", "".join(figs)), ("Cases", case_table(ds)),
+            ("Convergence", convergence_table(ds)), ("Stability", stability_section(ds)),
+            *extra_sections, ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
+            ("Provenance", prov_html)]
+    n_steady = int(np.sum(ds["case_steady"].values > 0))
+    lead = (f"<p class='lead'>{n} cases, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
+            f"{wall / 60:.0f} min of simulation wall time. Does this campaign reproduce the "
+            "conclusions of Lapillonne et al. (SPHERIC 2022)?</p>")
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
                        for t, c in body)
     return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
             f"<title>sph-surge campaign report</title><style>{CSS}</style></head><body>"
-            f"<h1>sph-surge campaign report</h1><nav><ul>{toc}</ul></nav>{sections}</body></html>")
+            f"<h1>sph-surge campaign report</h1>{lead}<nav><ul>{toc}</ul></nav>{sections}</body></html>")
 
 
 def write(text: str, path) -> None:

@@ -1,0 +1,42 @@
+"""The report's figures from a synthetic campaign: every registered figure draws; dp axes in
+mm with plain tick labels; one legend entry per Ch; the GCI band on the finest point."""
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
+
+from campaign_data import STATIONS, campaign
+from study import figures
+
+
+def metric(name, dp, ch, sh):
+    if name == "zeta_u":
+        return np.array([0.04, 0.03, 0.01]) + 2 * dp
+    return 0.001 + 5 * dp * ch  # first order, monotone: a GCI exists
+
+
+def test_every_registered_figure_draws(tmp_path):
+    ds = campaign(metric, steady=lambda dp, ch, sh: dp > 0.001)
+    z = np.linspace(0, 1, 11)
+    theory = xr.Dataset({"velocity": (("station", "z_star"), np.tile(1.5 * z, (STATIONS.size, 1)))},
+                        coords={"station": STATIONS, "z_star": z})
+    paths = figures.write_all(ds, tmp_path, figures.Settings(1.8, theory), dpi=40)
+    assert [p.stem for p in paths] == list(figures.FIGURE_NAMES)
+    assert all(p.stat().st_size > 1000 for p in paths)
+
+
+def test_dp_axis_legend_and_gci_band():
+    ds = campaign(metric, steady=lambda dp, ch, sh: dp > 0.001)
+    with plt.rc_context(figures.STYLE):
+        fig = figures._metric_figure(ds, "zeta_f", "zeta_f")
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    ticks = [t.get_text() for t in ax.get_xticklabels() if t.get_text()]
+    assert ticks == ["4", "2", "1"]  # the campaign's dp in mm, no 10^x notation
+    assert ax.get_xlabel() == "particle spacing dp [mm]"
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == ["Ch = 1.5", "Ch = 1.8", "Ch = 2.2", "steady window", "final window, not steady"]
+    bars = [c for c in ax.containers if c.__class__.__name__ == "ErrorbarContainer"]
+    assert len(bars) == 3  # one GCI band per Ch, on the finest point
+    seg = bars[0].lines[2][0].get_segments()[0]
+    assert seg[0][0] == seg[1][0] == 1.0  # at dp = 1 mm
+    plt.close(fig)

@@ -1,0 +1,49 @@
+"""The HTML report from a synthetic campaign: the verdict on the first screen, and the page
+as headless Chromium renders it (images decoded, nothing fetched from outside)."""
+import numpy as np
+import pytest
+import xarray as xr
+
+from campaign_data import STATIONS, campaign
+from study import figures
+from study.browser import check_report, find_browser
+from study.report import render, write
+from study.verdict import verdicts
+from test_verdict import paper_like
+
+
+def test_the_report_opens_with_the_verdict():
+    ds = campaign(paper_like, steady=lambda dp, ch, sh: dp > 0.001)
+    text = render(ds, [], "grid: {}")
+    assert text.index("<h2>Verdict</h2>") < text.index("<h2>Accuracy and cost</h2>") < text.index(
+        "<h2>Configuration</h2>")
+    for v in verdicts(ds):
+        assert v.claim in text.replace("&#x27;", "'")
+    assert text.count("runs that are not steady</b>") == 6  # every verdict here rests on them
+    assert "dp for 1 %" in text and "mm</td>" in text  # the dp needed, in mm
+
+
+browser = pytest.mark.skipif(find_browser() is None,
+                             reason="no Chromium (Debian: apt-get install chromium); .ci/run installs it")
+
+
+@browser
+def test_the_report_in_a_real_browser(tmp_path):
+    """Headless Chromium: every figure decodes, nothing is fetched from outside the file, and
+    the first screen shows the verdict (screenshot saved)."""
+    ds = campaign(paper_like, steady=lambda dp, ch, sh: dp > 0.001)
+    z = np.linspace(0, 1, 11)
+    theory = xr.Dataset({"velocity": (("station", "z_star"), np.tile(1.5 * z, (STATIONS.size, 1)))},
+                        coords={"station": STATIONS, "z_star": z})
+    paths = figures.write_all(ds, tmp_path / "figs", figures.Settings(1.8, theory), dpi=40)
+    figs = [(p, s.title, s.full_caption(1.8)) for p, s in zip(paths, figures.FIGURES)]
+    write(render(ds, figs, "grid: {}"), tmp_path / "report.html")
+    r = check_report(tmp_path / "report.html", screenshot=tmp_path / "first_screen.png")
+    assert r.ok and len(r.images) == len(figures.FIGURES), (r.broken, r.external)
+    assert (tmp_path / "first_screen.png").stat().st_size > 10_000
+    # a page with a broken image and an outside request fails the same check
+    bad = tmp_path / "bad.html"
+    bad.write_text('<html><body><img alt="broken" src="data:image/png;base64,AAAA">'
+                   '<img alt="outside" src="http://example.invalid/x.png"></body></html>')
+    r = check_report(bad)
+    assert r.broken == ["broken", "outside"] and r.external == ["http://example.invalid/x.png"]

@@ -1,0 +1,102 @@
+"""The verdict on each conclusion of the paper, from synthetic campaign datasets whose
+metrics follow known laws zeta(dp) = limit + C dp."""
+import math
+
+import numpy as np
+import pytest
+
+from campaign_data import campaign
+from study.verdict import extrapolate, verdicts
+
+CLAIMS = ("zeta_f", "zeta_h", "zeta_fs", "zeta_u", "lind_better", "marginal")
+
+
+def paper_like(name, dp, ch, sh):
+    """Every conclusion of the paper holds: zeta_f 0.6 % and zeta_h -> 5 %, lind better."""
+    lind = 0.5 if sh == "lind" else 1.0
+    if name == "zeta_f":
+        return lind * (0.001 + 5 * dp)
+    if name in ("zeta_h", "zeta_h_paper"):
+        return (0.05 + 10 * dp) * (0.8 if sh == "lind" else 1.0)
+    if name == "zeta_fs":
+        return 0.02 + 20 * dp
+    return np.array([0.04, 0.03, 0.01]) + 2 * dp + (0.002 if sh == "lind" else 0.0)
+
+
+def opposite(name, dp, ch, sh):
+    """Every conclusion fails beyond doubt: zeta_f tends to 3 %, zeta_h to 1 %, zeta_fs grows
+    with refinement, zeta_u is smallest at the toe, lind is worse by 2x (zeta_u 3x)."""
+    lind = 2.0 if sh == "lind" else 1.0
+    if name == "zeta_f":
+        return lind * (0.03 + 5 * dp)
+    if name in ("zeta_h", "zeta_h_paper"):
+        return lind * (0.01 + 10 * dp)
+    if name == "zeta_fs":
+        return 0.05 - 10 * dp
+    return (3.0 if sh == "lind" else 1.0) * (np.array([0.01, 0.03, 0.04]) + 2 * dp)
+
+
+def undecided(name, dp, ch, sh):
+    """Oscillating or mixed sequences; lind better on one metric, worse on the other."""
+    wiggle = {0.004: 0.03, 0.002: 0.02, 0.001: 0.025}[dp]
+    if name == "zeta_f":
+        return wiggle * (0.5 if sh == "lind" else 1.0)
+    if name in ("zeta_h", "zeta_h_paper"):
+        return wiggle * (2.0 if sh == "lind" else 1.0)
+    if name == "zeta_fs":
+        return wiggle
+    return np.array([0.06, 0.03, 0.02]) * (1.5 if sh == "lind" else 1.0)
+
+
+def by_claim(ds):
+    return dict(zip(CLAIMS, verdicts(ds)))
+
+
+def test_every_conclusion_reproduced():
+    v = by_claim(campaign(paper_like))
+    assert {k: x.verdict for k, x in v.items()} == dict.fromkeys(CLAIMS, "reproduced")
+    assert all(not x.unsteady for x in v.values())
+    assert "Limit at Ch 1.8: 5 %" in v["zeta_h"].evidence
+    assert v["lind_better"].cases == ["dp1mm_ch1.8_lind", "dp1mm_ch1.8_skillen"]
+
+
+def test_every_conclusion_contradicted():
+    v = by_claim(campaign(opposite))
+    assert {k: x.verdict for k, x in v.items()} == dict.fromkeys(CLAIMS, "contradicted")
+    assert "limit 3 %" in v["zeta_f"].evidence  # the extrapolation rules 1 % out
+    assert "not about 5 %" in v["zeta_h"].evidence
+
+
+def test_undecided_sequences_are_not_reproduced():
+    v = by_claim(campaign(undecided))
+    for k in ("zeta_f", "zeta_h", "zeta_fs", "zeta_u", "lind_better", "marginal"):
+        assert v[k].verdict == "not reproduced", (k, v[k])
+
+
+def test_a_verdict_on_runs_that_are_not_steady_says_so():
+    finest_unsteady = lambda dp, ch, sh: dp > 0.001  # noqa: E731
+    v = by_claim(campaign(paper_like, steady=finest_unsteady))
+    assert v["zeta_f"].verdict == "reproduced"  # the numbers still read the same
+    assert v["zeta_f"].unsteady == ["dp1mm_ch1.5_skillen", "dp1mm_ch1.8_skillen", "dp1mm_ch2.2_skillen"]
+    assert v["lind_better"].unsteady == ["dp1mm_ch1.8_lind", "dp1mm_ch1.8_skillen"]
+
+
+def test_diverged_runs_give_no_data_or_fall_back_to_coarser_ones():
+    v = by_claim(campaign(paper_like, status=lambda dp, ch, sh: "diverged"))
+    assert {x.verdict for x in v.values()} == {"no data"}
+    fine_lind_diverged = lambda dp, ch, sh: "diverged" if (sh, dp) == ("lind", 0.001) else "completed"  # noqa: E731
+    v = by_claim(campaign(paper_like, status=fine_lind_diverged))
+    assert "dp = 2 mm" in v["lind_better"].evidence  # the finest dp where both finished
+
+
+def test_extrapolation_and_the_dp_needed():
+    dp = np.array([0.004, 0.002, 0.001])
+    x = extrapolate(dp, 20 * dp)  # zeta = 20 dp: 2 % at 1 mm, first order, limit 0
+    assert x.status == "monotone" and x.order == pytest.approx(1.0)
+    assert x.extrapolated == pytest.approx(0.0, abs=1e-12)
+    assert x.dp_needed == pytest.approx(0.0005)
+    x = extrapolate(dp, 0.005 + 1e4 * dp ** 2)  # second order, limit 0.5 %: 1 % at dp = sqrt(5e-7)
+    assert x.order == pytest.approx(2.0) and x.dp_needed == pytest.approx(math.sqrt(5e-7))
+    assert extrapolate(dp, 0.02 + dp).dp_needed == math.inf  # the limit is above 1 %
+    assert extrapolate(dp, 0.001 + dp).dp_needed == 0.001  # already met at the finest dp
+    assert extrapolate(dp, [0.03, 0.02, 0.025]).status == "oscillatory"

@@ -1,0 +1,359 @@
+"""Does the campaign reproduce the paper's conclusions? Pure functions over the campaign
+dataset (study.campaign.build): one verdict per conclusion, and per metric the cheapest
+steady run under a threshold, the GCI-extrapolated value and the dp needed for 1 %.
+
+Verdicts:
+- ``reproduced``: our numbers at the finest dp show the claim;
+- ``contradicted``: they show the opposite beyond their uncertainty (a threshold that even
+  the extrapolation to dp -> 0 misses by more than its GCI band; a difference of the other
+  sign that is resolved; errors growing with refinement);
+- ``not reproduced``: neither (e.g. the error is above the threshold at our finest dp but
+  the extrapolation does not rule the threshold out);
+- ``no data``: the runs the claim needs are missing or diverged.
+A verdict whose evidence includes runs that were not steady says so (``unsteady``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+from .convergence import gci
+
+PAPER_CH = 1.8
+PAPER_FINEST_DP = 0.25e-3
+RESOLVED = 0.10  # a difference between two runs below this fraction of the larger is a tie
+MARGINAL_U = 0.01  # |delta zeta_u| below which shifting "marginally" affects zeta_u (1 % of u_b)
+
+
+@dataclass
+class Verdict:
+    claim: str
+    verdict: str  # reproduced | not reproduced | contradicted | no data
+    evidence: str
+    cases: list[str] = field(default_factory=list)  # the runs the verdict rests on
+    unsteady: list[str] = field(default_factory=list)  # those of them that were not steady
+
+
+@dataclass
+class Extrapolation:
+    """GCI over the three finest dp of one metric sequence, and what it implies."""
+    status: str
+    finest: float = math.nan
+    extrapolated: float = math.nan
+    band: float = math.nan  # absolute uncertainty of the finest value: GCI_fine |finest|
+    order: float = math.nan
+    dp_needed: float = math.nan  # dp [m] at which the metric reaches the target; inf: never
+
+
+def main_method(ds: xr.Dataset) -> str:
+    """The shifting method run at the most Ch values (the first listed on a tie): the
+    paper's Figs. 2-6 method."""
+    shs = [str(s) for s in ds["shifting"].values]
+    counts = [int((ds["status"].sel(shifting=s) != "missing").any("dp").sum()) for s in shs]
+    return shs[int(np.argmax(counts))]
+
+
+def paper_ch(ds: xr.Dataset) -> float:
+    return float(ds["ch"].sel(ch=PAPER_CH, method="nearest"))
+
+
+def _finite_dp(da: xr.DataArray) -> xr.DataArray:
+    """A (dp,) sequence with only its finite values (diverged and missing runs drop out)."""
+    return da.where(np.isfinite(da), drop=True)
+
+
+def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
+    """GCI of a metric over dp; the dp at which phi(dp) = phi_ext + C dp^p reaches ``target``."""
+    dp = np.asarray(dp, dtype=float)
+    phi = np.asarray(phi, dtype=float)
+    ok = np.isfinite(dp) & np.isfinite(phi)
+    dp, phi = dp[ok], phi[ok]
+    if dp.size == 0:
+        return Extrapolation("no data")
+    i1 = int(np.argmin(dp))
+    r = gci(dp, phi)
+    out = Extrapolation(r.status, finest=float(phi[i1]))
+    if r.status != "monotone":
+        return out
+    out.extrapolated, out.order = r.extrapolated, r.order
+    out.band = r.gci_fine * abs(out.finest)
+    if out.finest <= target:
+        out.dp_needed = float(dp[i1])
+    elif out.extrapolated >= target:
+        out.dp_needed = math.inf
+    else:
+        out.dp_needed = float(dp[i1] * ((target - out.extrapolated) / (out.finest - out.extrapolated)) ** (1 / r.order))
+    return out
+
+
+def _status_note(ds, sel_list):
+    """Case ids of the selections, and those not steady (finished but flagged)."""
+    cases, unsteady = [], []
+    for sel in sel_list:
+        cid = str(ds["case_id"].sel(**sel).values)
+        if not cid:
+            continue
+        cases.append(cid)
+        if str(ds["status"].sel(**sel).values) != "diverged" and not float(ds["steady"].sel(**sel)) > 0:
+            unsteady.append(cid)
+    return cases, unsteady
+
+
+def _finest_dp_with(ds, var, ch, sh, station=None):
+    """The finest dp at which (ch, sh) gave a finite ``var``; None if none did."""
+    da = ds[var].sel(ch=ch, shifting=sh)
+    if station is not None:
+        da = da.sel(station=station)
+    da = _finite_dp(da)
+    return None if da.sizes["dp"] == 0 else float(da["dp"].min())
+
+
+def _pct(v):
+    return "-" if not np.isfinite(v) else f"{100 * v:.2g} %"
+
+
+def _mm(dp):
+    return f"{dp * 1000:g} mm"
+
+
+def threshold_claim(ds, var, threshold, chs, sh, need, claim, station=None):
+    """``var`` below ``threshold`` at the finest dp for at least ``need`` of ``chs``."""
+    met, ruled_out, parts, sels = 0, 0, [], []
+    for ch in chs:
+        dp = _finest_dp_with(ds, var, ch, sh, station)
+        if dp is None:
+            parts.append(f"Ch {ch:g}: no run")
+            continue
+        da = ds[var].sel(ch=ch, shifting=sh)
+        if station is not None:
+            da = da.sel(station=station)
+        x = extrapolate(da["dp"].values, da.values, threshold)
+        v = float(da.sel(dp=dp))
+        sels.append(dict(dp=dp, ch=ch, shifting=sh))
+        if v < threshold:
+            met += 1
+        elif x.status == "monotone" and x.extrapolated - x.band > threshold:
+            ruled_out += 1
+        note = f" (limit {_pct(x.extrapolated)} ± {_pct(x.band)})" if x.status == "monotone" else ""
+        parts.append(f"Ch {ch:g}: {_pct(v)} at {_mm(dp)}{note}")
+    if not sels:
+        return Verdict(claim, "no data", "no finished run", [], [])
+    need = min(need, len(chs))
+    if met >= need:
+        verdict = "reproduced"
+    elif len(sels) - ruled_out < need:
+        verdict = "contradicted"
+    else:
+        verdict = "not reproduced"
+    evidence = f"{sh}: " + "; ".join(parts) + f". Below {_pct(threshold)}: {met} of {len(chs)} Ch"
+    return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
+
+
+def trend(dp, phi) -> str:
+    """'decreasing' (each finer dp no worse, the finest better than the coarsest),
+    'increasing' (the reverse), 'mixed', or 'insufficient' (fewer than two values)."""
+    dp = np.asarray(dp, dtype=float)
+    phi = np.asarray(phi, dtype=float)
+    ok = np.isfinite(dp) & np.isfinite(phi)
+    if ok.sum() < 2:
+        return "insufficient"
+    order = np.argsort(dp[ok])[::-1]  # coarse to fine
+    d = np.diff(phi[ok][order])
+    if np.all(d <= 0) and d.sum() < 0:
+        return "decreasing"
+    if np.all(d >= 0) and d.sum() > 0:
+        return "increasing"
+    return "mixed"
+
+
+def converging_claim(ds, var, chs, sh, claim, about=None):
+    """``var`` falls with refinement for most of ``chs``; with ``about`` = (value, factor),
+    also that its GCI limit at the paper's Ch lies within that factor of the value."""
+    counts = {"decreasing": 0, "increasing": 0, "mixed": 0, "insufficient": 0}
+    sels, parts = [], []
+    for ch in chs:
+        da = _finite_dp(ds[var].sel(ch=ch, shifting=sh))
+        t = trend(da["dp"].values, da.values)
+        counts[t] += 1
+        sels += [dict(dp=float(d), ch=ch, shifting=sh) for d in da["dp"].values]
+        if da.sizes["dp"]:
+            seq = ", ".join(_pct(float(v)) for v in da.values)
+            parts.append(f"Ch {ch:g}: {seq} ({t})")
+    if not sels:
+        return Verdict(claim, "no data", "no finished run", [], [])
+    n = len(chs) - counts["insufficient"]
+    if n == 0:
+        verdict = "not reproduced"
+    elif counts["decreasing"] > n / 2:
+        verdict = "reproduced"
+    elif counts["increasing"] > n / 2:
+        verdict = "contradicted"
+    else:
+        verdict = "not reproduced"
+    evidence = f"{sh}, dp coarse to fine: " + "; ".join(parts)
+    if about is not None and verdict == "reproduced":
+        value, factor = about
+        ch = paper_ch(ds)
+        da = ds[var].sel(ch=ch, shifting=sh)
+        x = extrapolate(da["dp"].values, da.values)
+        if x.status != "monotone":
+            verdict = "not reproduced"
+            evidence += f". At Ch {ch:g} the sequence is {x.status}: no limit to compare with {_pct(value)}"
+        else:
+            lo, hi = x.extrapolated - x.band, x.extrapolated + x.band
+            evidence += f". Limit at Ch {ch:g}: {_pct(x.extrapolated)} ± {_pct(x.band)}"
+            if hi < value / factor or lo > value * factor:
+                verdict = "contradicted"
+                evidence += f", not about {_pct(value)} (outside a factor {factor:g})"
+    return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
+
+
+def _value(ds, var, sel, station=None):
+    da = ds[var].sel(**sel)
+    if station is not None:
+        da = da.sel(station=station)
+    return float(da)
+
+
+def lind_better_claim(ds, claim):
+    """Lind below Skillen on zeta_f and zeta_h at the paper's Ch, at the finest dp where both
+    finished. A difference below RESOLVED of the larger value is a tie."""
+    shs = [str(s) for s in ds["shifting"].values]
+    if "lind" not in shs or "skillen" not in shs:
+        return Verdict(claim, "no data", "the campaign does not run both methods", [], [])
+    ch = paper_ch(ds)
+    both = [float(d) for d in ds["dp"].values
+            if all(np.isfinite(_value(ds, v, dict(dp=d, ch=ch, shifting=s)))
+                   for v in ("zeta_f", "zeta_h") for s in ("lind", "skillen"))]
+    if not both:
+        return Verdict(claim, "no data", f"no dp where both methods finished at Ch {ch:g}", [], [])
+    dp = min(both)
+    better, worse, parts = 0, 0, []
+    for var in ("zeta_f", "zeta_h"):
+        lv = _value(ds, var, dict(dp=dp, ch=ch, shifting="lind"))
+        sv = _value(ds, var, dict(dp=dp, ch=ch, shifting="skillen"))
+        if abs(lv - sv) <= RESOLVED * max(lv, sv):
+            word = "tie"
+        elif lv < sv:
+            word, better = "lind better", better + 1
+        else:
+            word, worse = "skillen better", worse + 1
+        parts.append(f"{var}: lind {_pct(lv)}, skillen {_pct(sv)} ({word})")
+    verdict = "reproduced" if better == 2 else "contradicted" if worse == 2 else "not reproduced"
+    evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts)
+    sels = [dict(dp=dp, ch=ch, shifting=s) for s in ("lind", "skillen")]
+    return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
+
+
+def marginal_shifting_claim(ds, claim):
+    """At the paper's Ch and the finest dp where both finished: reproduced when at every
+    station |zeta_u(lind) - zeta_u(skillen)| is below MARGINAL_U or a tie (RESOLVED);
+    contradicted when at some station one method's error is more than twice the other's
+    and the difference above both."""
+    shs = [str(s) for s in ds["shifting"].values]
+    if "lind" not in shs or "skillen" not in shs:
+        return Verdict(claim, "no data", "the campaign does not run both methods", [], [])
+    ch = paper_ch(ds)
+    st = ds["station"].values
+    both = [float(d) for d in ds["dp"].values
+            if all(np.isfinite(_value(ds, "zeta_u", dict(dp=d, ch=ch, shifting=s), station=x))
+                   for s in ("lind", "skillen") for x in st)]
+    if not both:
+        return Verdict(claim, "no data", f"no dp where both methods finished at Ch {ch:g}", [], [])
+    dp = min(both)
+    marginal, large, parts = 0, 0, []
+    for x in st:
+        lv = _value(ds, "zeta_u", dict(dp=dp, ch=ch, shifting="lind"), station=x)
+        sv = _value(ds, "zeta_u", dict(dp=dp, ch=ch, shifting="skillen"), station=x)
+        diff = abs(lv - sv)
+        if diff <= MARGINAL_U or diff <= RESOLVED * max(lv, sv):
+            marginal += 1
+        elif max(lv, sv) > 2 * min(lv, sv):
+            large += 1
+        parts.append(f"x* = {x:g}: lind {lv:.3f}, skillen {sv:.3f}")
+    verdict = ("reproduced" if marginal == st.size else "contradicted" if large else "not reproduced")
+    evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts)
+    sels = [dict(dp=dp, ch=ch, shifting=s) for s in ("lind", "skillen")]
+    return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
+
+
+def velocity_claim(ds, claim):
+    """zeta_u below 5 % at the finest dp at every station, and largest at the station nearest
+    the toe, for most Ch of the main method."""
+    sh = main_method(ds)
+    st = ds["station"].values
+    toe = int(np.argmin(st))
+    below, toe_largest, toe_smallest, n, parts, sels = 0, 0, 0, 0, [], []
+    for ch in ds["ch"].values:
+        dps = [_finest_dp_with(ds, "zeta_u", ch, sh, station=x) for x in st]
+        if any(d is None for d in dps):
+            continue
+        dp = max(dps)  # the finest dp where every station has a value
+        u = np.array([_value(ds, "zeta_u", dict(dp=dp, ch=ch, shifting=sh), station=x) for x in st])
+        n += 1
+        below += bool(np.all(u < 0.05))
+        toe_largest += bool(u[toe] >= u.max())
+        toe_smallest += bool(u.size > 1 and u[toe] < np.delete(u, toe).min())
+        sels.append(dict(dp=dp, ch=float(ch), shifting=sh))
+        parts.append(f"Ch {ch:g} at {_mm(dp)}: " + ", ".join(f"{v:.3f}" for v in u))
+    if n == 0:
+        return Verdict(claim, "no data", "no finished run", [], [])
+    if below > n / 2 and toe_largest > n / 2:
+        verdict = "reproduced"
+    elif toe_smallest > n / 2:
+        verdict = "contradicted"
+    else:
+        verdict = "not reproduced"
+    evidence = (f"{sh}, zeta_u at x* = " + ", ".join(f"{x:g}" for x in st) + ": " + "; ".join(parts)
+                + f". All below 5 %: {below} of {n} Ch; largest at x* = {st[toe]:g}: {toe_largest} of {n}")
+    return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
+
+
+def verdicts(ds: xr.Dataset) -> list[Verdict]:
+    """One verdict per conclusion of the paper, in its order."""
+    sh = main_method(ds)
+    chs = [float(c) for c in ds["ch"].values if (ds["status"].sel(ch=c, shifting=sh) != "missing").any()]
+    return [
+        threshold_claim(ds, "zeta_f", 0.01, chs, sh, 3,
+                        "zeta_f below 1 % at the finest dp for three Ch"),
+        converging_claim(ds, "zeta_h_paper", chs, sh,
+                         "zeta_h converges, to about 5 % (against the paper's normalising depth)",
+                         about=(0.05, 2.0)),
+        converging_claim(ds, "zeta_fs", chs, sh, "zeta_fs converges"),
+        velocity_claim(ds, "zeta_u below 5 % at the finest dp, largest near the toe"),
+        lind_better_claim(ds, "Lind better than Skillen on zeta_f and zeta_h at Ch = 1.8"),
+        marginal_shifting_claim(ds, "the shifting method affects zeta_u only marginally"),
+    ]
+
+
+METRICS = (("zeta_f", None), ("zeta_h", None), ("zeta_h_paper", None), ("zeta_fs", None),
+           ("zeta_u", "station"))
+
+
+def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
+    """Per metric (zeta_u per station) and shifting method at the paper's Ch: the cheapest
+    steady run meeting each threshold (over the whole grid), the GCI limit and band, and the
+    dp that the observed order says is needed for 1 %."""
+    from .pareto import cheapest_meeting
+    ch = paper_ch(ds)
+    cost = np.where(ds["case_steady"].values > 0, ds["case_wall_time"].values, np.nan)
+    rows = []
+    for var, dim in METRICS:
+        stations = ds["station"].values if dim else [None]
+        for x in stations:
+            label = var if x is None else f"{var} (x* = {x:g})"
+            err = ds[f"case_{var}"].values if x is None else ds["case_zeta_u"].sel(station=x).values
+            cheapest = {}
+            for thr in thresholds:
+                i = cheapest_meeting(cost, err, thr)
+                cheapest[thr] = None if i is None else (str(ds["case"].values[i]), float(cost[i]), float(err[i]))
+            for sh in ds["shifting"].values:
+                da = ds[var].sel(ch=ch, shifting=sh)
+                if x is not None:
+                    da = da.sel(station=x)
+                rows.append(dict(metric=label, shifting=str(sh), ch=ch, cheapest=cheapest,
+                                 extrapolation=extrapolate(da["dp"].values, da.values, 0.01)))
+    return rows
