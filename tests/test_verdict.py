@@ -100,3 +100,4 @@ def test_extrapolation_and_the_dp_needed():
     assert extrapolate(dp, 0.02 + dp).dp_needed == math.inf  # the limit is above 1 %
     assert extrapolate(dp, 0.001 + dp).dp_needed == 0.001  # already met at the finest dp
     assert extrapolate(dp, [0.03, 0.02, 0.025]).status == "oscillatory"
+    assert extrapolate(dp, -0.002 + 10 * dp).extrapolated == 0.0  # a limit below 0 means "vanishes"

@@ -64,8 +64,11 @@ def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", inve
             ax.xaxis.set_major_locator(FixedLocator(np.asarray(dp_ticks, dtype=float)))
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             ax.xaxis.set_minor_formatter(NullFormatter())
+        else:
+            ax.xaxis.set_major_formatter(FuncFormatter(_plain))
         ax.yaxis.set_major_formatter(FuncFormatter(_plain))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _plain(v, _) if _few_decades(ax) else ""))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _plain(v) if _few_decades(ax)
+                                                   and _mantissa(v) in (2, 3, 5) else ""))
     else:
         ax.text(0.5, 0.5, "no run gave this metric\n(diverged)", transform=ax.transAxes,
                 ha="center", va="center", color="0.4")
@@ -75,6 +78,10 @@ def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", inve
 def _plain(v, _pos=None) -> str:
     """A tick label without exponent notation: 0.003, 0.02, 1, 30."""
     return f"{v:.4g}" if 1e-4 <= abs(v) < 1e5 else f"{v:.0e}"
+
+
+def _mantissa(v: float) -> int:
+    return round(v / 10 ** np.floor(np.log10(v))) if v > 0 else 0
 
 
 def _few_decades(ax) -> bool:

@@ -249,7 +249,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
             ("Provenance", prov_html)]
     n_steady = int(np.sum(ds["case_steady"].values > 0))
     lead = (f"<p class='lead'>{n} cases, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
-            f"{wall / 60:.0f} min of simulation wall time. Does this campaign reproduce the "
+            f"{wall / 60:.0f} min of simulation wall time summed over the cases. Does this campaign reproduce the "
             "conclusions of Lapillonne et al. (SPHERIC 2022)?</p>")
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'

@@ -66,7 +66,8 @@ def _finite_dp(da: xr.DataArray) -> xr.DataArray:
 
 
 def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
-    """GCI of a metric over dp; the dp at which phi(dp) = phi_ext + C dp^p reaches ``target``."""
+    """GCI of a metric over dp; the dp at which phi(dp) = phi_ext + C dp^p reaches ``target``.
+    The metrics are errors, never negative: a negative Richardson limit is reported as 0."""
     dp = np.asarray(dp, dtype=float)
     phi = np.asarray(phi, dtype=float)
     ok = np.isfinite(dp) & np.isfinite(phi)
@@ -78,7 +79,7 @@ def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
     out = Extrapolation(r.status, finest=float(phi[i1]))
     if r.status != "monotone":
         return out
-    out.extrapolated, out.order = r.extrapolated, r.order
+    out.extrapolated, out.order = max(r.extrapolated, 0.0), r.order
     out.band = r.gci_fine * abs(out.finest)
     if out.finest <= target:
         out.dp_needed = float(dp[i1])
