@@ -32,6 +32,7 @@ from savings import METRICS, metrics_of, run_case  # noqa: E402
 VARIANTS = {
     "shipped": [],
     "cfl_0.4": ["cfl=0.4"],
+    "cfl_0.4_viscous_0.2": ["cfl=0.4", "cfl_viscous=0.2"],
     "average_1s": ["steady.average=1.0"],
     "cfl_0.3": ["cfl=0.3"],
     "cfl_0.3_average_1s": ["cfl=0.3", "steady.average=1.0"],

@@ -83,6 +83,7 @@ class ConveyorCase(YamlData):
     normalising_depth: float = 0.0186  # m: the paper's h_n used to normalise its data
     coefsound: float = 10.0
     cfl: float = 0.2
+    cfl_viscous: float | None = None  # C of the viscous limit alone; null: cfl
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False
@@ -156,6 +157,8 @@ def validate_case(c: ConveyorCase) -> None:
     for key in ("dp", "density", "viscosity", "gravity", "fluid_length", "wall_height",
                 "normalising_depth", "coefsound", "cfl", "max_area_drift", "checkpoint_interval"):
         positive(getattr(c, key), f"case.{key}")
+    if c.cfl_viscous is not None:
+        positive(c.cfl_viscous, "case.cfl_viscous")
     if not 0 < c.slope_deg < 90:
         raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
     if c.start not in START_SHAPES:
@@ -289,6 +292,7 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
         "gravity": [g * math.sin(th), -g * math.cos(th)],
         "sound": {"coefsound": c.coefsound, "depth": hn},
         "cfl": c.cfl,
+        "cfl_viscous": c.cfl_viscous,
         "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
                     "density_diffusion": c.density_diffusion,
                     "density_diffusion_reference": c.density_diffusion_reference,

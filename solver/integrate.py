@@ -64,11 +64,17 @@ def kick(u, w, rho, kind, ax, az, drho, drho_prev, n, dt, rho0, clamp_boundary, 
         drho_prev[i] = drho[i]
 
 
-def time_step(cfl, h, amax, vmax, c0, nu):
-    """(dt, index of the limiting term, (dt1, dt2, dt3)) of SPEC eq. 7."""
+def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None):
+    """(dt, index of the limiting term, (dt1, dt2, dt3)) of SPEC eq. 7:
+    dt = min(C dt1, C dt2, C_nu dt3), C = ``cfl``, C_nu = ``cfl_viscous`` (default C, when
+    this is C min(dt1, dt2, dt3) as SPEC writes it)."""
     dt1 = math.sqrt(h / amax) if amax > 0 else math.inf
     dt2 = h / (c0 + vmax)
     dt3 = h * h / nu
     limits = (dt1, dt2, dt3)
-    k = int(np.argmin(limits))
-    return cfl * limits[k], k, limits
+    if cfl_viscous is None:
+        k = int(np.argmin(limits))
+        return cfl * limits[k], k, limits
+    scaled = (cfl * dt1, cfl * dt2, cfl_viscous * dt3)
+    k = int(np.argmin(scaled))
+    return scaled[k], k, limits

@@ -198,6 +198,7 @@ class Scene(YamlData):
     walls: list[Wall] = field(default_factory=list)
     gravity: tuple[float, float] = (0.0, -9.81)
     cfl: float = 0.2
+    cfl_viscous: float | None = None  # C of the viscous limit dt3 alone; null: cfl (SPEC eq. 7)
     periodic_x: tuple[float, float] | None = None
     domain: Domain | None = None
     physics: Physics = field(default_factory=Physics)
@@ -396,6 +397,8 @@ def validate(scene: Scene) -> None:
     if not 0.5 <= scene.ch <= 4.0:
         raise SceneError(f"ch: h/dp must lie in [0.5, 4], got {scene.ch}")
     _positive(scene.cfl, "cfl")
+    if scene.cfl_viscous is not None:
+        _positive(scene.cfl_viscous, "cfl_viscous")
     _positive(scene.fluid.density, "fluid.density")
     _validate_rheology(scene)
     if not scene.fluid.blocks and not scene.fluid.profiles:

@@ -194,7 +194,7 @@ class Simulation:
 
     def _update_dt(self):
         dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0,
-                                         self.nu_max_now)
+                                         self.nu_max_now, self.scene.cfl_viscous)
         self.info = StepInfo(dt, k, lim)
 
     def _shift(self, dt: float):

@@ -50,7 +50,7 @@ def test_grid_product_paper_and_extra_cases():
 
 def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():
     c = load("config.yaml")
-    c["grid"]["exclude"] = []
+    c["grid"] = {"dp": [0.003], "ch": [1.0, 1.8], "shifting": ["lind"]}
     with pytest.raises(cfgmod.ConfigError) as exc:
         cfgmod.validate(c)
     msg = str(exc.value)
@@ -63,7 +63,7 @@ def test_configs_validate_and_expand():
     cs = cfgmod.cases(default)
     assert len(cs) == 10  # Ch 1.8 x both methods x 3 dp; skillen at Ch 1.3 and 2.2 on the two coarser
     dps = sorted({c.dp for c in cs})
-    assert dps[0] == 0.001 and dps[1] / dps[0] == dps[2] / dps[1] == 1.5  # constant ratio to 1 mm
+    assert dps[0] == 0.001 and dps[1] / dps[0] == pytest.approx(dps[2] / dps[1]) == 1.5  # constant ratio
     assert {c.shifting for c in cs if c.dp == 0.001 and c.ch == 1.8} == {"skillen", "lind"}
     paper = cfgmod.validate(load("paper.yaml"))
     cs = cfgmod.cases(paper)

@@ -40,3 +40,14 @@ def test_velocity_update_is_first_order_in_dt():
     # the time error at the CFL step is small against the plate speed (measured 0.3 %)
     U0 = example_scene("couette").walls[1].velocity[0]
     assert diffs[0] * 2 < 0.005 * U0  # |u(dt) - u(0)| ~ 2 |u(dt) - u(dt/2)| for order 1
+
+
+def test_the_viscous_limit_takes_its_own_coefficient():
+    """dt = min(C dt1, C dt2, C_nu dt3); without C_nu it is C min(dt1, dt2, dt3) (SPEC eq. 7)."""
+    from solver.integrate import time_step
+    h, amax, vmax, c0, nu = 1.8e-3, 9.81, 0.1, 4.29, 5.6 / 1383  # the paper case at dp = 1 mm
+    dt1, dt2, dt3 = math.sqrt(h / amax), h / (c0 + vmax), h * h / nu
+    assert time_step(0.2, h, amax, vmax, c0, nu) == (0.2 * dt2, 1, (dt1, dt2, dt3))
+    assert time_step(0.4, h, amax, vmax, c0, nu, cfl_viscous=0.25)[:2] == (0.4 * dt2, 1)  # acoustic
+    assert time_step(0.4, h, amax, vmax, c0, nu, cfl_viscous=0.2)[:2] == (0.2 * dt3, 2)  # 1.600 < 1.640e-4
+    assert time_step(0.4, h, amax, vmax, c0, nu)[:2] == (0.4 * dt2, 1)  # one C: the acoustic limit

@@ -73,6 +73,14 @@ def test_undecided_sequences_are_not_reproduced():
         assert v[k].verdict == "not reproduced", (k, v[k])
 
 
+def test_a_limit_far_from_5_percent_is_not_about_5_percent():
+    """zeta_h -> 1.5 %: outside a factor 2 of the paper's 5 %, though its GCI band reaches 2.8 %."""
+    def low_limit(name, dp, ch, sh):
+        return 0.015 + 10 * dp if name in ("zeta_h", "zeta_h_paper") else paper_like(name, dp, ch, sh)
+    v = by_claim(campaign(low_limit))["zeta_h"]
+    assert v.verdict == "not reproduced" and "Limit at Ch 1.8: 1.5 % ± 1.3 %" in v.evidence
+
+
 def test_a_verdict_on_runs_that_are_not_steady_says_so():
     finest_unsteady = lambda dp, ch, sh: dp > 0.001  # noqa: E731
     v = by_claim(campaign(paper_like, steady=finest_unsteady))

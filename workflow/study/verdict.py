@@ -172,7 +172,9 @@ def trend(dp, phi) -> str:
 
 def converging_claim(ds, var, chs, sh, claim, about=None):
     """``var`` falls with refinement for most of ``chs``; with ``about`` = (value, factor),
-    also that its GCI limit at the paper's Ch lies within that factor of the value."""
+    also that its GCI limit at the paper's Ch lies within that factor of the value
+    (contradicted when the whole GCI band lies outside it, not reproduced when only the
+    limit does)."""
     counts = {"decreasing": 0, "increasing": 0, "mixed": 0, "insufficient": 0}
     sels, parts = [], []
     for ch in chs:
@@ -209,6 +211,10 @@ def converging_claim(ds, var, chs, sh, claim, about=None):
             if hi < value / factor or lo > value * factor:
                 verdict = "contradicted"
                 evidence += f", not about {_pct(value)} (outside a factor {factor:g})"
+            elif not value / factor <= x.extrapolated <= value * factor:
+                verdict = "not reproduced"
+                evidence += (f": the limit lies outside a factor {factor:g} of {_pct(value)}, "
+                             "its band does not")
     return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
 
 
