@@ -399,7 +399,7 @@ FIGURES = (
     FigureSpec("fig11_cost_vs_error", "Run time against error",
                "Wall time of each case against each error metric (log-log), with the Pareto "
                "front (no case is both cheaper and more accurate) labelled by dp, Ch and "
-               "shifting (steady and not-steady runs alike; the Cost table counts steady runs "
+               "shifting (steady and not-steady runs alike; the Accuracy and cost table counts steady runs "
                "only). Not in the paper: it answers which run is the cheapest one to trust.",
                lambda ds, st: fig_cost_vs_error(ds)),
     FigureSpec("fig12_stability_map", "Stability map",
