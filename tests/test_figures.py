@@ -40,3 +40,12 @@ def test_dp_axis_legend_and_gci_band():
     seg = bars[0].lines[2][0].get_segments()[0]
     assert seg[0][0] == seg[1][0] == 1.0  # at dp = 1 mm
     plt.close(fig)
+
+
+def test_fig7_colours_by_speed_only_when_the_dataset_has_speeds():
+    ds = campaign(metric)
+    with_speed = figures.fig_front_particles(ds, 1.8)
+    assert [a.get_ylabel() for a in with_speed.axes][-1] == "|u| / u_b (lab frame)"  # the colour bar
+    without = figures.fig_front_particles(ds.drop_vars("front_speed"), 1.8)
+    assert len(without.axes) == len(with_speed.axes) - 1  # no colour bar, one colour
+    plt.close("all")

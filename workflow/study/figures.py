@@ -156,7 +156,8 @@ def _metric_figure(ds, var, ylabel):
 HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over the final window "
           "of a run that did not reach steady state (read them as indicative only). Error bars on "
           "the finest dp: the GCI band of that value (Celik et al. 2008), where the three finest "
-          "dp converge monotonically.")
+          "dp converge monotonically; on the log axis a band that reaches zero is drawn down to "
+          "5 % of the value.")
 
 
 def fig_velocity_profiles(ds, ch, ref):
@@ -200,16 +201,20 @@ def _front_panels(ds, ch, draw):
 
 
 def fig_front_particles(ds, ch):
-    """The final particles at the front coloured by their lab-frame speed |u| / u_b."""
+    """The final particles at the front coloured by their lab-frame speed |u| / u_b (one
+    colour where the campaign dataset has no speeds)."""
     speed = ds["front_speed"] if "front_speed" in ds else ds["front_x"] * np.nan
-    vmax = float(np.nanmax(speed.values)) if np.isfinite(speed.values).any() else 1.0
+    coloured = bool(np.isfinite(speed.values).any())
+    vmax = float(np.nanmax(speed.values)) if coloured else 1.0
     artists = []
 
     def draw(ax, sel, x, z):
         v = speed.sel(**sel).values
-        ok = np.isfinite(x)
-        artists.append(ax.scatter(x[ok], z[ok], s=4, c=np.nan_to_num(v[ok], nan=0.0), cmap="viridis",
-                                  vmin=0.0, vmax=vmax))
+        ok = np.isfinite(x) & (np.isfinite(v) if coloured else True)
+        if coloured:
+            artists.append(ax.scatter(x[ok], z[ok], s=4, c=v[ok], cmap="viridis", vmin=0.0, vmax=vmax))
+        else:
+            ax.scatter(x[ok], z[ok], s=4, color=COLOURS[0])
         ax.set_aspect("equal")
     fig = _front_panels(ds, ch, draw)
     if artists:
