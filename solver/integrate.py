@@ -71,10 +71,6 @@ def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None):
     dt1 = math.sqrt(h / amax) if amax > 0 else math.inf
     dt2 = h / (c0 + vmax)
     dt3 = h * h / nu
-    limits = (dt1, dt2, dt3)
-    if cfl_viscous is None:
-        k = int(np.argmin(limits))
-        return cfl * limits[k], k, limits
-    scaled = (cfl * dt1, cfl * dt2, cfl_viscous * dt3)
+    scaled = (cfl * dt1, cfl * dt2, (cfl if cfl_viscous is None else cfl_viscous) * dt3)
     k = int(np.argmin(scaled))
-    return scaled[k], k, limits
+    return scaled[k], k, (dt1, dt2, dt3)

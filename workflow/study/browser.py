@@ -45,8 +45,8 @@ class _Pipe:
     """DevTools protocol over the browser's pipe; ``call`` returns a command's result and
     keeps every event it reads in ``events``."""
 
-    def __init__(self, proc, to_browser, from_browser):
-        self.proc, self.out, self.inp = proc, to_browser, from_browser
+    def __init__(self, to_browser, from_browser):
+        self.out, self.inp = to_browser, from_browser
         self.next_id, self.buffer, self.events = 0, b"", []
 
     def _read(self, deadline):
@@ -107,7 +107,7 @@ def check_report(html_path, screenshot=None, width=1280, height=900, browser=Non
     os.close(r_to)
     os.close(w_from)
     try:
-        cdp = _Pipe(proc, w_to, r_from)
+        cdp = _Pipe(w_to, r_from)
         page = next(t for t in cdp.call("Target.getTargets")["targetInfos"] if t["type"] == "page")
         s = cdp.call("Target.attachToTarget", {"targetId": page["targetId"], "flatten": True})["sessionId"]
         cdp.call("Network.enable", session=s)

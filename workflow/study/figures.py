@@ -62,10 +62,8 @@ def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", inve
             ax.invert_xaxis()
         if dp_ticks is not None:
             ax.xaxis.set_major_locator(FixedLocator(np.asarray(dp_ticks, dtype=float)))
-            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             ax.xaxis.set_minor_formatter(NullFormatter())
-        else:
-            ax.xaxis.set_major_formatter(FuncFormatter(_plain))
+        ax.xaxis.set_major_formatter(FuncFormatter(_plain))
         ax.yaxis.set_major_formatter(FuncFormatter(_plain))
         ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _plain(v) if _few_decades(ax)
                                                    and _mantissa(v) in (2, 3, 5) else ""))

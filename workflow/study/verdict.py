@@ -103,11 +103,14 @@ def _status_note(ds, sel_list):
     return cases, unsteady
 
 
-def _finest_dp_with(ds, var, ch, sh, station=None):
-    """The finest dp at which (ch, sh) gave a finite ``var``; None if none did."""
+def _series(ds, var, ch, sh, station=None) -> xr.DataArray:
+    """``var`` over dp for one Ch and shifting method (and station)."""
     da = ds[var].sel(ch=ch, shifting=sh)
-    if station is not None:
-        da = da.sel(station=station)
+    return da if station is None else da.sel(station=station)
+
+
+def _finest_dp(da: xr.DataArray):
+    """The finest dp of a (dp,) sequence with a finite value; None if it has none."""
     da = _finite_dp(da)
     return None if da.sizes["dp"] == 0 else float(da["dp"].min())
 
@@ -120,17 +123,15 @@ def _mm(dp):
     return f"{dp * 1000:g} mm"
 
 
-def threshold_claim(ds, var, threshold, chs, sh, need, claim, station=None):
+def threshold_claim(ds, var, threshold, chs, sh, need, claim):
     """``var`` below ``threshold`` at the finest dp for at least ``need`` of ``chs``."""
     met, ruled_out, parts, sels = 0, 0, [], []
     for ch in chs:
-        dp = _finest_dp_with(ds, var, ch, sh, station)
+        da = _series(ds, var, ch, sh)
+        dp = _finest_dp(da)
         if dp is None:
             parts.append(f"Ch {ch:g}: no run")
             continue
-        da = ds[var].sel(ch=ch, shifting=sh)
-        if station is not None:
-            da = da.sel(station=station)
         x = extrapolate(da["dp"].values, da.values, threshold)
         v = float(da.sel(dp=dp))
         sels.append(dict(dp=dp, ch=ch, shifting=sh))
@@ -178,7 +179,7 @@ def converging_claim(ds, var, chs, sh, claim, about=None):
     counts = {"decreasing": 0, "increasing": 0, "mixed": 0, "insufficient": 0}
     sels, parts = [], []
     for ch in chs:
-        da = _finite_dp(ds[var].sel(ch=ch, shifting=sh))
+        da = _finite_dp(_series(ds, var, ch, sh))
         t = trend(da["dp"].values, da.values)
         counts[t] += 1
         sels += [dict(dp=float(d), ch=ch, shifting=sh) for d in da["dp"].values]
@@ -200,7 +201,7 @@ def converging_claim(ds, var, chs, sh, claim, about=None):
     if about is not None and verdict == "reproduced":
         value, factor = about
         ch = paper_ch(ds)
-        da = ds[var].sel(ch=ch, shifting=sh)
+        da = _series(ds, var, ch, sh)
         x = extrapolate(da["dp"].values, da.values)
         if x.status != "monotone":
             verdict = "not reproduced"
@@ -218,30 +219,32 @@ def converging_claim(ds, var, chs, sh, claim, about=None):
     return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
 
 
-def _value(ds, var, sel, station=None):
-    da = ds[var].sel(**sel)
-    if station is not None:
-        da = da.sel(station=station)
-    return float(da)
+def _value(ds, var, dp, ch, sh, station=None) -> float:
+    return float(_series(ds, var, ch, sh, station).sel(dp=dp))
+
+
+def _both_methods(ds, quantities):
+    """(Ch, dp, None): the paper's Ch and the finest dp where Lind and Skillen both gave
+    every (var, station) of ``quantities``; or (Ch, None, why not) when there is none."""
+    ch = paper_ch(ds)
+    if not {"lind", "skillen"} <= {str(s) for s in ds["shifting"].values}:
+        return ch, None, "the campaign does not run both methods"
+    both = [float(d) for d in ds["dp"].values
+            if all(np.isfinite(_value(ds, v, d, ch, s, x)) for v, x in quantities for s in ("lind", "skillen"))]
+    if not both:
+        return ch, None, f"no dp where both methods finished at Ch {ch:g}"
+    return ch, min(both), None
 
 
 def lind_better_claim(ds, claim):
     """Lind below Skillen on zeta_f and zeta_h at the paper's Ch, at the finest dp where both
     finished. A difference below RESOLVED of the larger value is a tie."""
-    shs = [str(s) for s in ds["shifting"].values]
-    if "lind" not in shs or "skillen" not in shs:
-        return Verdict(claim, "no data", "the campaign does not run both methods", [], [])
-    ch = paper_ch(ds)
-    both = [float(d) for d in ds["dp"].values
-            if all(np.isfinite(_value(ds, v, dict(dp=d, ch=ch, shifting=s)))
-                   for v in ("zeta_f", "zeta_h") for s in ("lind", "skillen"))]
-    if not both:
-        return Verdict(claim, "no data", f"no dp where both methods finished at Ch {ch:g}", [], [])
-    dp = min(both)
+    ch, dp, why_not = _both_methods(ds, [("zeta_f", None), ("zeta_h", None)])
+    if dp is None:
+        return Verdict(claim, "no data", why_not, [], [])
     better, worse, parts = 0, 0, []
     for var in ("zeta_f", "zeta_h"):
-        lv = _value(ds, var, dict(dp=dp, ch=ch, shifting="lind"))
-        sv = _value(ds, var, dict(dp=dp, ch=ch, shifting="skillen"))
+        lv, sv = (_value(ds, var, dp, ch, s) for s in ("lind", "skillen"))
         if abs(lv - sv) <= RESOLVED * max(lv, sv):
             word = "tie"
         elif lv < sv:
@@ -260,21 +263,13 @@ def marginal_shifting_claim(ds, claim):
     station |zeta_u(lind) - zeta_u(skillen)| is below MARGINAL_U or a tie (RESOLVED);
     contradicted when at some station one method's error is more than twice the other's
     and the difference above both."""
-    shs = [str(s) for s in ds["shifting"].values]
-    if "lind" not in shs or "skillen" not in shs:
-        return Verdict(claim, "no data", "the campaign does not run both methods", [], [])
-    ch = paper_ch(ds)
     st = ds["station"].values
-    both = [float(d) for d in ds["dp"].values
-            if all(np.isfinite(_value(ds, "zeta_u", dict(dp=d, ch=ch, shifting=s), station=x))
-                   for s in ("lind", "skillen") for x in st)]
-    if not both:
-        return Verdict(claim, "no data", f"no dp where both methods finished at Ch {ch:g}", [], [])
-    dp = min(both)
+    ch, dp, why_not = _both_methods(ds, [("zeta_u", x) for x in st])
+    if dp is None:
+        return Verdict(claim, "no data", why_not, [], [])
     marginal, large, parts = 0, 0, []
     for x in st:
-        lv = _value(ds, "zeta_u", dict(dp=dp, ch=ch, shifting="lind"), station=x)
-        sv = _value(ds, "zeta_u", dict(dp=dp, ch=ch, shifting="skillen"), station=x)
+        lv, sv = (_value(ds, "zeta_u", dp, ch, s, x) for s in ("lind", "skillen"))
         diff = abs(lv - sv)
         if diff <= MARGINAL_U or diff <= RESOLVED * max(lv, sv):
             marginal += 1
@@ -295,11 +290,11 @@ def velocity_claim(ds, claim):
     toe = int(np.argmin(st))
     below, toe_largest, toe_smallest, n, parts, sels = 0, 0, 0, 0, [], []
     for ch in ds["ch"].values:
-        dps = [_finest_dp_with(ds, "zeta_u", ch, sh, station=x) for x in st]
+        dps = [_finest_dp(_series(ds, "zeta_u", ch, sh, x)) for x in st]
         if any(d is None for d in dps):
             continue
         dp = max(dps)  # the finest dp where every station has a value
-        u = np.array([_value(ds, "zeta_u", dict(dp=dp, ch=ch, shifting=sh), station=x) for x in st])
+        u = np.array([_value(ds, "zeta_u", dp, ch, sh, x) for x in st])
         n += 1
         below += bool(np.all(u < 0.05))
         toe_largest += bool(u[toe] >= u.max())
@@ -358,9 +353,7 @@ def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
                 i = cheapest_meeting(cost, err, thr)
                 cheapest[thr] = None if i is None else (str(ds["case"].values[i]), float(cost[i]), float(err[i]))
             for sh in ds["shifting"].values:
-                da = ds[var].sel(ch=ch, shifting=sh)
-                if x is not None:
-                    da = da.sel(station=x)
+                da = _series(ds, var, ch, sh, x)
                 rows.append(dict(metric=label, shifting=str(sh), ch=ch, cheapest=cheapest,
                                  extrapolation=extrapolate(da["dp"].values, da.values, 0.01)))
     return rows
