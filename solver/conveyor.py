@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import lubrication, viscoplastic
-from .scene import Scene, SceneError, YamlData, parse_into, scene_from_dict
+from .scene import VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into, scene_from_dict
 from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication", "warm")
@@ -87,6 +87,7 @@ class ConveyorCase(YamlData):
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False
+    viscous_update: str = "explicit"  # or implicit: no viscous limit on dt (docs/numerics.md)
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
@@ -159,6 +160,9 @@ def validate_case(c: ConveyorCase) -> None:
         positive(getattr(c, key), f"case.{key}")
     if c.cfl_viscous is not None:
         positive(c.cfl_viscous, "case.cfl_viscous")
+    if c.viscous_update not in VISCOUS_UPDATES:
+        raise SceneError(f"case.viscous_update: {c.viscous_update!r} is not one of "
+                         f"{', '.join(VISCOUS_UPDATES)}")
     if not 0 < c.slope_deg < 90:
         raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
     if c.start not in START_SHAPES:
@@ -296,7 +300,8 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
         "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
                     "density_diffusion": c.density_diffusion,
                     "density_diffusion_reference": c.density_diffusion_reference,
-                    "viscous_correction": c.viscous_correction, "shifting": shifting},
+                    "viscous_correction": c.viscous_correction,
+                    "viscous_update": c.viscous_update, "shifting": shifting},
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,

@@ -17,6 +17,7 @@ SHIFTING_METHODS = ("none", "skillen", "lind")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
+VISCOUS_UPDATES = ("explicit", "implicit")
 LIND_MIN_CH = 1.1  # below it Lind shifting fails on the conveyor case (docs/numerics.md)
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
 
@@ -151,6 +152,9 @@ class Physics:
     density_diffusion_reference: str = "spec"
     # remove the laminar term's first-order error 2 nu G . grad u where the support is full
     viscous_correction: bool = False
+    # explicit (SPEC: the laminar term at v^n, dt bounded by h^2 / nu) or implicit (backward
+    # Euler in the laminar term, no viscous limit on dt: solver/implicit.py)
+    viscous_update: str = "explicit"
     # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
     artificial_viscosity: float | None = None
     # floor the fluid density at rho0 after each step: no negative pressure, no tensile clumping
@@ -426,6 +430,9 @@ def validate(scene: Scene) -> None:
     if ph.mdbc_velocity not in MDBC_VELOCITY:
         raise SceneError(
             f"physics.mdbc_velocity: {ph.mdbc_velocity!r} is not one of {', '.join(MDBC_VELOCITY)}")
+    if ph.viscous_update not in VISCOUS_UPDATES:
+        raise SceneError(
+            f"physics.viscous_update: {ph.viscous_update!r} is not one of {', '.join(VISCOUS_UPDATES)}")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
     if ph.artificial_viscosity is not None and not 0 <= ph.artificial_viscosity <= 1:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from . import boundary, cells, forces, guards, integrate, rheology, shifting
+from . import boundary, cells, forces, guards, implicit, integrate, rheology, shifting
 from .build import Particles, build_particles
 from .scene import Scene
 
@@ -82,6 +82,12 @@ class Simulation:
                                                 self.variable_viscosity)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ()))
+        self.implicit = s.physics.viscous_update == "implicit"
+        if self.implicit:
+            self.assemble_viscous = implicit.make_assembly(self.variable_viscosity)
+            self.viscous_table = implicit.allocate(self.n, implicit.table_width(s.ch))
+            self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
+        self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
         self.mdbc = s.physics.boundary == "mdbc"
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
@@ -174,6 +180,8 @@ class Simulation:
         self.vmax = float(self.vmax_t.max())
         if self.viscous_correction:
             forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active)
+        if self.implicit:  # with the viscosities the pair loop used
+            self._assemble_viscous()
         if self.variable_viscosity:  # the viscosity of the next evaluation
             fl = s.fluid
             self.nu_max_now = rheology.update_viscosity(
@@ -181,6 +189,34 @@ class Simulation:
                 fl.consistency, fl.index, fl.max_viscosity, fl.papanastasiou or 0.0)
         if self.correct_shift:
             self._correct_density()
+        return ""
+
+    def _assemble_viscous(self):
+        """The implicit laminar term's coefficients at this evaluation (``implicit``),
+        widening the table when a row does not fit."""
+        while True:
+            tab = self.viscous_table
+            self.assemble_viscous(self.x, self.z, self.rho, self.mass, self.kind, self.nu_p, self.nu,
+                                  self.h, 2.0 if self.mdbc else 1.0, self.cells, self.n_active, tab)
+            most = int(tab.count[:self.n_active].max()) if self.n_active else 0
+            if most <= tab.cols.shape[1]:
+                return
+            self.viscous_table = implicit.allocate(self.n, most + 8)
+
+    def _solve_viscous(self, dt: float) -> str:
+        """Replace the evaluation's accelerations by (v^{n+1} - v^n) / dt of backward Euler in
+        the laminar term; the force limit of the next step takes their maximum."""
+        o = self.out
+        it, res = implicit.solve(self.viscous_table, self.mass, self.kind, dt, o[forces.AX], o[forces.AZ],
+                                 self.n_active, implicit.TOLERANCE, implicit.MAX_ITERATIONS,
+                                 self.solver_work)
+        self.solver_iterations += it
+        if not res <= implicit.TOLERANCE:
+            return (f"implicit viscous solve: relative residual {res:.3g} after {it} iterations "
+                    f"(tolerance {implicit.TOLERANCE:g})")
+        n = self.n_active
+        fluid = self.kind[:n] == 0
+        self.amax = float(np.hypot(o[forces.AX, :n][fluid], o[forces.AZ, :n][fluid]).max(initial=0.0))
         return ""
 
     def _correct_density(self):
@@ -194,7 +230,8 @@ class Simulation:
 
     def _update_dt(self):
         dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0,
-                                         self.nu_max_now, self.scene.cfl_viscous)
+                                         self.nu_max_now, self.scene.cfl_viscous,
+                                         viscous_limit=not self.implicit)
         self.info = StepInfo(dt, k, lim)
 
     def _shift(self, dt: float):
@@ -239,6 +276,8 @@ class Simulation:
         integrate.advance_density(self.rho, self.drho_prev, self.n_active, 0.5 * dt)
         self._wrap()
         reason = self._evaluate(t + 0.5 * dt)
+        if not reason and self.implicit:
+            reason = self._solve_viscous(dt)
         if reason:
             return self._stop(reason)
         o = self.out
