@@ -11,8 +11,11 @@ with dt and N measured at (dp, Ch = 1.8) and scaled to other Ch by the dp = 1 mm
 its steady time plus averaging window (--t-sim, per method, measured at dp = 1 mm: see
 benchmarks/time_to_solution.py) and, as the upper bound, the grid's max_time.
 
+With --set KEY=VALUE (case keys, e.g. viscous_update=implicit cfl=0.4) every run takes
+those settings; with viscous_update=implicit the dt scaling drops the viscous limit.
+
 Usage: python benchmarks/paper_grid.py [--threads 2] [--time 0.05] [--fine-time 0.02]
-           [--t-sim skillen=7.8 lind=12.4] [--out results/paper_grid] [--reuse]
+           [--t-sim skillen=7.8 lind=12.4] [--set KEY=VALUE ...] [--out results/paper_grid] [--reuse]
 Prints the measured runs and the projection as Markdown.
 """
 from __future__ import annotations
@@ -28,13 +31,14 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def measure(dp: float, ch: float, method: str, sim_time: float) -> dict:
+def measure(dp: float, ch: float, method: str, sim_time: float, settings: dict | None = None) -> dict:
     from solver.conveyor import case_from_dict
     from solver.front import run_front
     from solver.scene import read_yaml
     paper = yaml.safe_load((ROOT / "config" / "paper.yaml").read_text())["case"]
     d = read_yaml(ROOT / "examples" / "conveyor.yaml")
     d.update({k: v for k, v in paper.items() if k not in ("probes", "steady")})
+    d.update(settings or {})
     d.update(dp=dp, ch=ch, shifting=method, name=f"dp{dp * 1e3:g}mm_ch{ch:g}_{method}")
     d["steady"].update(max_time=sim_time)
     tic = time.perf_counter()
@@ -56,7 +60,9 @@ def main(argv=None):
     ap.add_argument("--t-sim", nargs="+", default=["skillen=7.8", "lind=12.4"])
     ap.add_argument("--out", default=str(ROOT / "results" / "paper_grid"))
     ap.add_argument("--reuse", action="store_true", help="project from OUT/runs.json, measure nothing")
+    ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="case settings of every run")
     a = ap.parse_args(argv)
+    settings = {k: yaml.safe_load(v) for k, v in (kv.split("=", 1) for kv in a.set)}
     numba.set_num_threads(a.threads)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -68,13 +74,13 @@ def main(argv=None):
     if a.reuse:
         runs = json.loads((out / "runs.json").read_text())
     else:
-        measure(0.002, 1.8, "skillen", 0.01)  # compile
+        measure(0.002, 1.8, "skillen", 0.01, settings)  # compile
         runs = []
         for method in ("skillen", "lind"):
             for ch in chs:
-                runs.append(measure(0.001, ch, method, a.time))
-            runs.append(measure(0.0005, paper_ch, method, a.time))
-            runs.append(measure(0.00025, paper_ch, method, a.fine_time))
+                runs.append(measure(0.001, ch, method, a.time, settings))
+            runs.append(measure(0.0005, paper_ch, method, a.time, settings))
+            runs.append(measure(0.00025, paper_ch, method, a.fine_time, settings))
         (out / "runs.json").write_text(json.dumps(runs, indent=1))
     print("| dp [mm] | Ch | shifting | particles | simulated [s] | steps | dt [s] | wall [s] | M particle-steps/s |")
     print("|---|---|---|---|---|---|---|---|---|")
@@ -90,8 +96,10 @@ def main(argv=None):
     cases += [(dp, paper_ch, "lind") for dp in grid["grid"]["dp"]]
     nu = grid["case"]["viscosity"] / grid["case"]["density"]
 
+    implicit = settings.get("viscous_update") == "implicit"
+
     def limit(h, c0):
-        return min(h / c0, h * h / nu)
+        return h / c0 if implicit else min(h / c0, h * h / nu)
 
     total_meas = total_max = 0.0
     rows = []

@@ -48,13 +48,32 @@ DIVDR = 8                             # shifting density correction: div(dr) of 
 # consistent viscous term: sum_b V_b gradW_ab, sum_b V_b (u_b - u_a) gradW_ab, div r with m/rho
 VGX, VGZ, DUX, DUZ, DWX, DWZ, VDIVR = 9, 10, 11, 12, 13, 14, 15
 NQ_BASE, NQ_SHIFT, NQ_CORRECTED, NQ_VISCOUS = 3, 8, 9, 16
+# implicit viscosity: the diagonal sum_b c_ab of the backward-Euler system goes in the last slot
 
 
 def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
-            velocity_gradient: bool = False) -> int:
+            velocity_gradient: bool = False, implicit: bool = False) -> int:
     if viscous_correction or velocity_gradient:
-        return NQ_VISCOUS
-    return NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
+        nq = NQ_VISCOUS
+    else:
+        nq = NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
+    return nq + 1 if implicit else nq
+
+
+class PairList(NamedTuple):
+    """Fluid-fluid pairs (i, j) and their laminar weights k_ij = -4 nu_ij (r.gradW) /
+    ((rho_i + rho_j)(r^2 + eta^2)) (symmetric, >= 0), listed by the thread that visited them:
+    thread t's are [0, count[t]) of row t; more than the capacity counts but is not stored."""
+    i: np.ndarray      # (threads, capacity) int32
+    j: np.ndarray      # (threads, capacity) int32
+    k: np.ndarray      # (threads, capacity) float64
+    count: np.ndarray  # (threads,) int64
+
+
+def pair_list(threads: int, capacity: int) -> PairList:
+    return PairList(np.zeros((threads, capacity), dtype=np.int32),
+                    np.zeros((threads, capacity), dtype=np.int32),
+                    np.zeros((threads, capacity)), np.zeros(threads, dtype=np.int64))
 
 
 # Binomial series of (1 + x)^(1/7) - 1 to x^5, split into even and odd powers: f(+-x) = E +- O.
@@ -201,20 +220,28 @@ def concentration_terms(dp2, F, dx, dz, rdotg):
 @functools.cache
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
                    column_reference: bool = False, viscous_correction: bool = False,
-                   artificial: bool = False, variable_viscosity: bool = False):
+                   artificial: bool = False, variable_viscosity: bool = False,
+                   implicit_walls: float = 0.0):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
     divergence (for the density correction) in or out; ``column_reference`` picks the
     diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
     of ``correct_viscous_term``; ``artificial`` adds Monaghan's artificial viscosity (all
     pairs, walls included, as DualSPHysics); ``variable_viscosity`` takes each pair's
     viscosity from the particles' nu_p (``pair_viscosity``) and sums the velocity gradient
-    into slots DUX..DWZ (``rheology``)."""
+    into slots DUX..DWZ (``rheology``). ``implicit_walls`` > 0 (implicit viscosity,
+    ``solver.implicit``) lists the fluid pairs and their laminar weights (``PairList``) and sums
+    the diagonal sum_b m_b k_ab into the last slot, fluid-wall pairs weighted by
+    ``implicit_walls`` (2 for mDBC, 1 for DBC walls)."""
     velocity_gradient = viscous_correction or variable_viscosity
+    implicit = implicit_walls > 0.0
+    DIAG = n_slots(shifting, shift_correction, viscous_correction, variable_viscosity)
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-    def pair_loop(f, cl, split, k, acc, vmax):
+    def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
         """acc[t, i, :] += the pair sums of the particles thread t writes (``PairFields`` f,
-        ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2)."""
+        ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
+        with implicit viscosity, thread t's fluid pairs in row t of the ``PairList`` arrays
+        (passed one by one: numba 0.68 loses writes to arrays held in a tuple inside prange)."""
         x, z, u, w, rho, p, mass, kind = f.x, f.z, f.u, f.w, f.rho, f.p, f.mass, f.kind
         start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
         h, nu, hc0, rho0, dp2 = k.h, k.nu, k.hc0, k.rho0, k.dp2
@@ -230,6 +257,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
             if periodic and split[t + 1] == ncx:
                 at[0:start[ncz]] = 0.0
             vm = 0.0
+            npl = 0
+            cap = pair_i.shape[1]
             for ix in range(split[t], split[t + 1]):
                 for iz in range(ncz):
                     ca = ix * ncz + iz
@@ -260,6 +289,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             s_ax = s_az = s_drho = 0.0
                             s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
                             s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
+                            s_diag = 0.0
                             sxa = sza = 0.0
                             if shift_correction:
                                 sxa, sza = f.sdx[a], f.sdz[a]
@@ -301,6 +331,19 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 s_az += mb * fz
                                 at[b, AX] -= ma * fx
                                 at[b, AZ] -= ma * fz
+                                if implicit:  # k_ab = -vt
+                                    if ka + kb == 0:
+                                        if npl < cap:
+                                            pair_i[t, npl] = a
+                                            pair_j[t, npl] = b
+                                            pair_k[t, npl] = -vt
+                                        npl += 1
+                                        s_diag -= mb * vt
+                                        at[b, DIAG] -= ma * vt
+                                    elif kb == 1:
+                                        s_diag -= implicit_walls * mb * vt
+                                    else:
+                                        at[b, DIAG] -= implicit_walls * ma * vt
                                 vr = abs(h * vdotr * inv_r2e)
                                 if vr > vm:
                                     vm = vr
@@ -368,12 +411,15 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 at[a, VGX] += s_vgx
                                 at[a, VGZ] += s_vgz
                                 at[a, VDIVR] += s_vdivr
+                            if implicit:
+                                at[a, DIAG] += s_diag
                             if velocity_gradient:
                                 at[a, DUX] += s_dux
                                 at[a, DUZ] += s_duz
                                 at[a, DWX] += s_dwx
                                 at[a, DWZ] += s_dwz
             vmax[t] = vm
+            pair_count[t] = npl
 
     return pair_loop
 

@@ -73,22 +73,19 @@ class Simulation:
         self.correct_shift = shifting_on and s.shift_density_correction
         self.viscous_correction = bool(s.physics.viscous_correction)
         self.variable_viscosity = not s.fluid.newtonian
+        self.implicit = s.physics.viscous_update == "implicit"
+        self.mdbc = s.physics.boundary == "mdbc"
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
-                                 self.variable_viscosity)
+                                 self.variable_viscosity, self.implicit)
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
                                                 s.physics.density_diffusion_reference == "column",
                                                 self.viscous_correction,
                                                 bool(s.physics.artificial_viscosity),
-                                                self.variable_viscosity)
+                                                self.variable_viscosity,
+                                                (2.0 if self.mdbc else 1.0) if self.implicit else 0.0)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ()))
-        self.implicit = s.physics.viscous_update == "implicit"
-        if self.implicit:
-            self.assemble_viscous = implicit.make_assembly(self.variable_viscosity)
-            self.viscous_table = implicit.allocate(self.n, implicit.table_width(s.ch))
-            self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
-        self.mdbc = s.physics.boundary == "mdbc"
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
         self.n_lattice = boundary.lattice_number_density(s.ch)
@@ -103,6 +100,12 @@ class Simulation:
         self.vwall_final = boundary.wall_velocities(s.walls, self.ramps_end)
 
         self.nthreads = nb.get_num_threads()
+        # implicit viscosity: the pair loop's list of fluid pairs, CG scratch
+        cap = implicit.pair_capacity(self.n, s.ch, self.nthreads) if self.implicit else 0
+        self.pairs = forces.pair_list(self.nthreads, cap)
+        if self.implicit:
+            self.rows = implicit.rows_for(self.nthreads, self.n, cap)
+            self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
         self.acc = np.zeros((self.nthreads, self.n, self.nq))
         self.out = np.zeros((self.nq, self.n))
         self.vmax_t = np.zeros(self.nthreads)
@@ -174,14 +177,18 @@ class Simulation:
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p)
-        self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t)
+        self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
+        if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
+            # more pairs than the list holds: widen it and evaluate again
+            cap = int(1.25 * self.pairs.count.max())
+            self.pairs = forces.pair_list(self.nthreads, cap)
+            self.rows = implicit.rows_for(self.nthreads, self.n, cap)
+            self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.cells,
                                                s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
         if self.viscous_correction:
             forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active)
-        if self.implicit:  # with the viscosities the pair loop used
-            self._assemble_viscous()
         if self.variable_viscosity:  # the viscosity of the next evaluation
             fl = s.fluid
             self.nu_max_now = rheology.update_viscosity(
@@ -191,30 +198,19 @@ class Simulation:
             self._correct_density()
         return ""
 
-    def _assemble_viscous(self):
-        """The implicit laminar term's coefficients at this evaluation (``implicit``),
-        widening the table when a row does not fit."""
-        while True:
-            tab = self.viscous_table
-            self.assemble_viscous(self.x, self.z, self.rho, self.mass, self.kind, self.nu_p, self.nu,
-                                  self.h, 2.0 if self.mdbc else 1.0, self.cells, self.n_active, tab)
-            most = int(tab.count[:self.n_active].max()) if self.n_active else 0
-            if most <= tab.cols.shape[1]:
-                return
-            self.viscous_table = implicit.allocate(self.n, most + 8)
-
     def _solve_viscous(self, dt: float) -> str:
         """Replace the evaluation's accelerations by (v^{n+1} - v^n) / dt of backward Euler in
         the laminar term; the force limit of the next step takes their maximum."""
         o = self.out
-        it, res = implicit.solve(self.viscous_table, self.mass, self.kind, dt, o[forces.AX], o[forces.AZ],
-                                 self.n_active, implicit.TOLERANCE, implicit.MAX_ITERATIONS,
+        n = self.n_active
+        implicit.sort_pairs(*self.pairs[:3], self.pairs.count, self.mass, n, self.rows)
+        it, res = implicit.solve(*self.rows[:3], o[self.nq - 1], self.mass, self.kind, dt, o[forces.AX],
+                                 o[forces.AZ], n, implicit.TOLERANCE, implicit.MAX_ITERATIONS,
                                  self.solver_work)
         self.solver_iterations += it
         if not res <= implicit.TOLERANCE:
             return (f"implicit viscous solve: relative residual {res:.3g} after {it} iterations "
                     f"(tolerance {implicit.TOLERANCE:g})")
-        n = self.n_active
         fluid = self.kind[:n] == 0
         self.amax = float(np.hypot(o[forces.AX, :n][fluid], o[forces.AZ, :n][fluid]).max(initial=0.0))
         return ""
@@ -332,7 +328,8 @@ class Simulation:
         reason = self._evaluate(self.t)
         if reason:
             raise RuntimeError(reason)
-        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r", "wall_nx", "wall_nz", "div_dr")[:self.nq]
+        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r", "wall_nx", "wall_nz",
+                 "div_dr")[:self.nq - self.implicit]
         inv = self._inverse_order()
         return {k: self.out[q][inv].copy() for q, k in enumerate(names)}
 

@@ -28,25 +28,31 @@ def jittered_couette(jitter=0.2, seed=1):
 
 
 def dense_operator(sim):
-    """C of the module docstring as a dense matrix over the fluid rows (in cell order), and
-    those rows' indices."""
-    tab = sim.viscous_table
+    """C of the module docstring as a dense matrix over the fluid rows (in cell order), the
+    rows' indices, and the number of times the pair list holds each fluid pair."""
+    pl = sim.pairs
     rows = np.flatnonzero(sim.kind[:sim.n_active] == 0)
-    pos = {a: i for i, a in enumerate(rows)}
-    C = np.zeros((rows.size, rows.size))
-    for i, a in enumerate(rows):
-        C[i, i] = tab.diag[a]
-        for j in range(tab.count[a]):
-            C[i, pos[tab.cols[a, j]]] -= tab.wts[a, j]
-    return C, rows
+    pos = np.full(sim.n, -1)
+    pos[rows] = np.arange(rows.size)
+    C = np.diag(sim.out[sim.nq - 1][rows])
+    listed = np.zeros((rows.size, rows.size), dtype=int)
+    m = sim.mass
+    for t in range(pl.count.size):
+        assert pl.count[t] <= pl.i.shape[1]
+        for a, b, k in zip(pl.i[t, :pl.count[t]], pl.j[t, :pl.count[t]], pl.k[t, :pl.count[t]]):
+            C[pos[a], pos[b]] -= m[b] * k
+            C[pos[b], pos[a]] -= m[a] * k
+            listed[pos[a], pos[b]] += 1
+            listed[pos[b], pos[a]] += 1
+    return C, rows, listed
 
 
-def test_the_table_holds_every_pair_and_the_weighted_operator_is_symmetric():
+def test_the_pair_list_holds_every_pair_once_and_the_weighted_operator_is_symmetric():
     """m_a c_ab = m_b c_ba (the system CG needs is symmetric), every fluid pair within 2h is
-    stored once per row, and a fluid particle's diagonal exceeds its fluid weights by its
+    listed exactly once, and a fluid particle's diagonal exceeds its fluid weights by its
     walls' (mDBC counts them twice)."""
     sc, sim = jittered_couette()
-    C, rows = dense_operator(sim)
+    C, rows, listed = dense_operator(sim)
     m = sim.mass[rows]
     MC = m[:, None] * C
     assert np.abs(MC - MC.T).max() <= 1e-12 * np.abs(MC).max()
@@ -55,7 +61,7 @@ def test_the_table_holds_every_pair_and_the_weighted_operator_is_symmetric():
     dx = x[:, None] - x[None, :]
     dx -= period * np.round(dx / period)
     near = (np.hypot(dx, z[:, None] - z[None, :]) < 2 * sc.h) & ~np.eye(rows.size, dtype=bool)
-    assert np.array_equal(near.sum(1), sim.viscous_table.count[rows])
+    assert np.array_equal(listed, near.astype(int))
     wall_share = C.diagonal() + (C - np.diag(C.diagonal())).sum(1)  # diag - sum of fluid weights
     walls = np.flatnonzero(sim.kind[:sim.n_active] != 0)
     wdx = x[:, None] - sim.x[walls][None, :]
@@ -67,10 +73,10 @@ def test_the_table_holds_every_pair_and_the_weighted_operator_is_symmetric():
 
 @pytest.mark.parametrize("dt_over_dt3", [0.2, 50.0])
 def test_conjugate_gradients_solve_the_backward_euler_system(dt_over_dt3):
-    """(I + dt C) delta = dt a, solved by CG to its relative tolerance 1e-8, against a dense
+    """(I + dt C) delta = dt a, solved by CG to a relative residual of 1e-10, against a dense
     solve of the same matrix, at a step below and far above the explicit viscous limit."""
     sc, sim = jittered_couette()
-    C, rows = dense_operator(sim)
+    C, rows, _ = dense_operator(sim)
     dt = dt_over_dt3 * sc.h ** 2 / sc.nu
     rng = np.random.default_rng(2)
     ax = np.zeros(sim.n)
@@ -80,12 +86,13 @@ def test_conjugate_gradients_solve_the_backward_euler_system(dt_over_dt3):
     A = np.eye(rows.size) + dt * C
     expect_x = np.linalg.solve(A, dt * ax[rows]) / dt
     expect_z = np.linalg.solve(A, dt * az[rows]) / dt
-    it, res = implicit.solve(sim.viscous_table, sim.mass, sim.kind, dt, ax, az, sim.n_active,
-                             implicit.TOLERANCE, implicit.MAX_ITERATIONS, sim.solver_work)
-    assert res <= implicit.TOLERANCE and 0 < it < implicit.MAX_ITERATIONS
+    implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, sim.n_active, sim.rows)
+    it, res = implicit.solve(*sim.rows[:3], sim.out[sim.nq - 1], sim.mass, sim.kind, dt, ax, az,
+                             sim.n_active, 1e-10, implicit.MAX_ITERATIONS, sim.solver_work)
+    assert res <= 1e-10 and 0 < it < implicit.MAX_ITERATIONS
     scale = np.abs(expect_x).max()
-    assert np.abs(ax[rows] - expect_x).max() < 1e-6 * scale
-    assert np.abs(az[rows] - expect_z).max() < 1e-6 * scale
+    assert np.abs(ax[rows] - expect_x).max() < 1e-8 * scale
+    assert np.abs(az[rows] - expect_z).max() < 1e-8 * scale
     walls = sim.kind[:sim.n_active] != 0
     assert not ax[:sim.n_active][walls].any()  # wall rows are not unknowns
 
