@@ -17,6 +17,7 @@ from tests.conftest import example_scene
 L_CHANNEL = 1.0e-3
 # (measured, bound) at t = 0.6 s: the L2 error still falls slowly (2.10 % at 1.2 s), so the
 # issue's 2 % is not met at the test's end time; the bound is the measurement plus 20 %.
+# Measured with the explicit update (0.0251) and with the example's implicit one (0.02505).
 HB_FILM_L2 = (0.0251, 0.030)
 # the computed plug is 6 % thinner than the exact 7.73 mm (5.6 % at 1.2 s): measured value
 # and the allowed deviation from it
@@ -72,8 +73,9 @@ def test_power_law_channel():
 def test_herschel_bulkley_film():
     """Carbopol-like film (tau_y = 20 Pa, K = 10 Pa s^n, n = 0.4) on the 15.3 deg incline.
     Velocity: see HB_FILM_L2. Plug: every particle above the exact yield surface h0 moves
-    within 1 % of the exact plug velocity (measured 0.73 %); the computed yield surface (where the
-    particle stress mu(gamma) gamma falls to tau_y) lies HB_FILM_YIELD above h0."""
+    within 1 % of the exact plug velocity (measured 0.75 % with the example's implicit
+    viscosity, 0.73 % explicit); the computed yield surface (where the particle stress
+    mu(gamma) gamma falls to tau_y) lies HB_FILM_YIELD above h0."""
     scene, z, u, gamma, nu = steady_state("hb_film")
     f = scene.fluid
     H = f.blocks[0].z[1]
@@ -82,7 +84,7 @@ def test_herschel_bulkley_film():
     u_plug = exact.herschel_bulkley_film(H, H, g_s, f.density, f.yield_stress, f.consistency, f.index)
     assert l2(u, ue, u_plug) < HB_FILM_L2[1], HB_FILM_L2
     h0 = H - f.yield_stress / (f.density * g_s)
-    assert np.abs(u[z > h0] / u_plug - 1).max() < 0.01  # measured 0.0073
+    assert np.abs(u[z > h0] / u_plug - 1).max() < 0.01  # measured 0.0075
     # computed yield surface: rows of mean particle stress, interpolated to tau_y
     rows = np.round(z / scene.dp - 0.5).astype(int)
     zr = np.array([z[rows == r].mean() for r in np.unique(rows)])
