@@ -29,6 +29,8 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--allow-diverged", action="store_true",
                    help="exit 0 when a diverged or unsteady run was written (campaigns record it)")
     w = sub.add_parser("warm", help="compile and cache every numba kernel (before parallel jobs)")
+    w.add_argument("cases", nargs="*", default=[],
+                   help="front case files whose settings to compile as well (at a coarse dp)")
     w.add_argument("--touch", default=None, help="file to create when done")
     return ap
 
@@ -123,25 +125,44 @@ def _front(args) -> int:
 
 
 def _warm(args) -> int:
-    """Step a tiny belt case with every shifting method, diffusion on and off, so that the
-    numba cache holds every kernel before parallel jobs start."""
+    """Step a tiny belt case with every shifting method, diffusion on and off, and each given
+    case's own settings at a coarse dp (h_n / 5), so that the numba cache holds the kernels
+    the campaign needs before parallel jobs start."""
+    import json
     import time
     from .conveyor import build_scene, case_from_dict
     from .front import FrontMonitor
     from .simulation import Simulation
-    from .scene import scene_from_dict
+    from .scene import read_yaml, scene_from_dict
+
+    def step_twice(case, boundary=None):
+        d = build_scene(case).to_dict()
+        if boundary:
+            d["physics"]["boundary"] = boundary
+        sim = Simulation(scene_from_dict(d))
+        for _ in range(2):
+            sim.step()
+        FrontMonitor(case)(sim)
+
     tic = time.perf_counter()
     for shifting in ("none", "skillen", "lind"):
         for diffusion in (0.1, None):
             case = case_from_dict({"dp": 0.004, "ch": 1.5, "shifting": shifting,
                                    "density_diffusion": diffusion})
             for boundary in ("mdbc", "dbc"):
-                d = build_scene(case).to_dict()
-                d["physics"]["boundary"] = boundary
-                sim = Simulation(scene_from_dict(d))
-                for _ in range(2):
-                    sim.step()
-            FrontMonitor(case)(sim)
+                step_twice(case, boundary)
+    seen = set()
+    for path in args.cases:
+        d = read_yaml(path)
+        d.pop("warm_from", None)
+        if d.get("start") == "warm":
+            d["start"] = "lubrication"
+        case = case_from_dict(d)
+        coarse = case_from_dict({**d, "dp": max(case.dp, case.h_n / 5)})
+        key = json.dumps(build_scene(coarse).to_dict()["physics"], sort_keys=True) + case.rheology
+        if key not in seen:
+            seen.add(key)
+            step_twice(coarse)
     print(f"numba kernels compiled and cached in {time.perf_counter() - tic:.1f} s", file=sys.stderr)
     if args.touch:
         from pathlib import Path

@@ -1,4 +1,6 @@
 rule compile_kernels:
+    input:
+        expand("results/cases/{case}/case.yaml", case=CASE_IDS),  # their settings are compiled too
     output:
         touch("results/.kernels_compiled"),
     log:
@@ -6,7 +8,7 @@ rule compile_kernels:
     params:
         solver=SOLVER_HASH,  # the kernels are cached per solver hash: a new solver compiles anew
     shell:
-        "python -m solver warm 2> {log}"
+        "python -m solver warm {input} 2> {log}"
 
 
 rule case_file:
@@ -24,7 +26,7 @@ rule case_file:
 rule run_case:
     input:
         case="results/cases/{case}/case.yaml",
-        kernels="results/.kernels_compiled",
+        kernels=ancient("results/.kernels_compiled"),  # compiled first; a recompile reruns nothing
         warm=warm_input,
     output:
         "results/cases/{case}/run.nc",
