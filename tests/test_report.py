@@ -23,6 +23,19 @@ def test_the_report_opens_with_the_verdict():
     assert "dp for 1 %" in text and "mm</td>" in text  # the dp needed, in mm
 
 
+def test_a_yield_stress_campaign_is_not_judged_against_the_newtonian_paper():
+    """The paper's conclusions concern a Newtonian fluid: a Herschel-Bulkley campaign's report
+    says so instead of giving verdicts on them."""
+    ds = campaign(paper_like, steady=lambda dp, ch, sh: dp > 0.001)
+    ds.attrs["rheology"] = "herschel_bulkley"
+    text = render(ds, [], "grid: {}")
+    assert "Does this campaign reproduce" not in text
+    assert "not judged here" in text and "herschel_bulkley" in text
+    for v in verdicts(ds):
+        assert v.claim not in text.replace("&#x27;", "'")
+    assert "<h2>Accuracy and cost</h2>" in text
+
+
 browser = pytest.mark.skipif(find_browser() is None,
                              reason="no Chromium (Debian: apt-get install chromium); .ci/run installs it")
 

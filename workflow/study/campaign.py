@@ -157,4 +157,6 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["case_safe"] = ("case", [int(stability.is_safe(r.attrs["status"], m)) for r, m in zip(runs, marg)],
                        {"long_name": f"survived with every margin below {stability.SAFE_FRACTION:g}"})
     ds["case_settings"] = ("case", [yaml.safe_dump(stability.case_settings(r), sort_keys=False) for r in runs])
+    rheologies = {yaml.safe_load(r.attrs["case_yaml"]).get("rheology", "newtonian") for r in runs}
+    ds.attrs["rheology"] = "newtonian" if rheologies == {"newtonian"} else ", ".join(sorted(rheologies))
     return ds

@@ -242,15 +242,22 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th>'
                                     f'<td class="l">{html.escape(str(v))}</td></tr>'
                                     for k, v in prov.items()) + "</table>"
-    body = [("Verdict", verdict_table(ds)), ("Accuracy and cost", accuracy_table(ds)),
+    newtonian = ds.attrs.get("rheology", "newtonian") == "newtonian"
+    verdict = verdict_table(ds) if newtonian else (
+        f"<p>The paper's conclusions are about a Newtonian fluid; this campaign's fluid is "
+        f"{html.escape(ds.attrs['rheology'])}, so they are not judged here. Its errors are against "
+        "the lubrication reference for that fluid: see Accuracy and cost, and the figures.</p>")
+    body = [("Verdict", verdict), ("Accuracy and cost", accuracy_table(ds)),
             ("Summary", summary), ("Figures", "".join(figs)), ("Cases", case_table(ds)),
             ("Convergence", convergence_table(ds)), ("Stability", stability_section(ds)),
             *extra_sections, ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
             ("Provenance", prov_html)]
     n_steady = int(np.sum(ds["case_steady"].values > 0))
+    question = ("Does this campaign reproduce the conclusions of Lapillonne et al. (SPHERIC 2022)?"
+                if newtonian else f"A {html.escape(ds.attrs['rheology'])} fluid: how close are its fronts to "
+                "the lubrication reference, and at what cost?")
     lead = (f"<p class='lead'>{n} cases, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
-            f"{wall / 60:.0f} min of simulation wall time summed over the cases. Does this campaign reproduce the "
-            "conclusions of Lapillonne et al. (SPHERIC 2022)?</p>")
+            f"{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
                        for t, c in body)
