@@ -149,3 +149,27 @@ def test_at_the_explicit_step_the_implicit_update_matches_the_exact_start_up():
         ue = exact.poiseuille(s["z"][f], sim.t, L_CHANNEL, F, sc.nu)
         errors.append(100 * np.sqrt(np.mean((s["u"][f] - ue) ** 2)) / u_max)
     assert all(e < b for e, b in zip(errors, (0.19, 1.11, 1.67))), errors
+
+
+def test_a_pair_list_that_overflows_is_widened_and_the_evaluation_repeated():
+    from solver import forces
+    sc, sim = jittered_couette()
+    C, rows, listed = dense_operator(sim)
+    sim.pairs = forces.pair_list(sim.nthreads, 16)
+    sim._evaluate(sim.t)
+    assert sim.pairs.i.shape[1] > 16
+    C2, rows2, listed2 = dense_operator(sim)
+    assert np.array_equal(rows, rows2) and np.array_equal(listed, listed2)
+    assert np.allclose(C, C2, rtol=1e-12, atol=0)
+
+
+def test_the_memory_estimate_covers_what_the_implicit_update_allocates():
+    """scene.implicit_bytes_per_particle against the arrays' own sizes (plus the fixed
+    1024 pairs of slack per thread)."""
+    from solver.scene import implicit_bytes_per_particle
+    sc, sim = jittered_couette()
+    held = (sum(a.nbytes for a in sim.pairs) + sum(a.nbytes for a in sim.rows)
+            + sim.solver_work.nbytes)
+    slack = sim.nthreads * 1024 * 40
+    assert held <= sim.n * implicit_bytes_per_particle(sc.ch) + slack + 64
+    assert held >= 0.9 * sim.n * implicit_bytes_per_particle(sc.ch)
