@@ -80,7 +80,7 @@ def main(argv=None):
         measure(0.002, 1.8, "skillen", 0.01, settings)  # compile
         runs = []
         for method in a.shifting:
-            for ch in chs:
+            for ch in (chs if method == "skillen" else [paper_ch]):  # the grid runs lind at paper_ch
                 runs.append(measure(0.001, ch, method, a.time, settings))
             runs.append(measure(0.0005, paper_ch, method, a.time, settings))
             runs.append(measure(0.00025, paper_ch, method, a.fine_time, settings))
