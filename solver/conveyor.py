@@ -72,6 +72,7 @@ class ConveyorCase(YamlData):
     index: float = 1.0
     max_viscosity: float | None = None
     papanastasiou: float | None = None
+    strain_rate_correction: bool = False  # herschel_bulkley: the smoothing bias of gamma removed
     slope_deg: float = 15.3
     gravity: float = 9.81
     belt: Belt = field(default_factory=Belt)
@@ -160,6 +161,8 @@ def validate_case(c: ConveyorCase) -> None:
         positive(getattr(c, key), f"case.{key}")
     if c.cfl_viscous is not None:
         positive(c.cfl_viscous, "case.cfl_viscous")
+    if c.newtonian and c.strain_rate_correction:
+        raise SceneError("case.strain_rate_correction: only for rheology herschel_bulkley")
     if c.viscous_update not in VISCOUS_UPDATES:
         raise SceneError(f"case.viscous_update: {c.viscous_update!r} is not one of "
                          f"{', '.join(VISCOUS_UPDATES)}")
@@ -312,7 +315,8 @@ def _rheology(c: ConveyorCase) -> dict:
     if c.newtonian:
         return {"viscosity": c.viscosity}
     return {"rheology": c.rheology, "yield_stress": c.yield_stress, "consistency": c.consistency,
-            "index": c.index, "max_viscosity": c.max_viscosity, "papanastasiou": c.papanastasiou}
+            "index": c.index, "max_viscosity": c.max_viscosity, "papanastasiou": c.papanastasiou,
+            "strain_rate_correction": c.strain_rate_correction}
 
 
 def build_scene(c: ConveyorCase, warm=None) -> Scene:

@@ -48,12 +48,17 @@ DIVDR = 8                             # shifting density correction: div(dr) of 
 # consistent viscous term: sum_b V_b gradW_ab, sum_b V_b (u_b - u_a) gradW_ab, div r with m/rho
 VGX, VGZ, DUX, DUZ, DWX, DWZ, VDIVR = 9, 10, 11, 12, 13, 14, 15
 NQ_BASE, NQ_SHIFT, NQ_CORRECTED, NQ_VISCOUS = 3, 8, 9, 16
+# corrected strain rate: the Laplacian of the last strain rate, and the support sum_b V_b (-F r^2) / 2
+LAPG, SUPP, NQ_STRAIN = 16, 17, 18
 # implicit viscosity: the diagonal sum_b c_ab of the backward-Euler system goes in the last slot
 
 
 def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
-            velocity_gradient: bool = False, implicit: bool = False) -> int:
-    if viscous_correction or velocity_gradient:
+            velocity_gradient: bool = False, implicit: bool = False,
+            strain_correction: bool = False) -> int:
+    if strain_correction:
+        nq = NQ_STRAIN
+    elif viscous_correction or velocity_gradient:
         nq = NQ_VISCOUS
     else:
         nq = NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
@@ -123,6 +128,7 @@ class PairFields(NamedTuple):
     sdx: np.ndarray
     sdz: np.ndarray
     nu_p: np.ndarray  # each particle's kinematic viscosity (read with variable_viscosity only)
+    gamma: np.ndarray  # each particle's last strain rate (read with strain_correction only)
 
 
 class PairConstants(NamedTuple):
@@ -221,7 +227,7 @@ def concentration_terms(dp2, F, dx, dz, rdotg):
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
                    column_reference: bool = False, viscous_correction: bool = False,
                    artificial: bool = False, variable_viscosity: bool = False,
-                   implicit_walls: float = 0.0):
+                   implicit_walls: float = 0.0, strain_correction: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
     divergence (for the density correction) in or out; ``column_reference`` picks the
     diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
@@ -231,10 +237,14 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     into slots DUX..DWZ (``rheology``). ``implicit_walls`` > 0 (implicit viscosity,
     ``solver.implicit``) lists the fluid pairs and their laminar weights (``PairList``) and sums
     the diagonal sum_b m_b k_ab into the last slot, fluid-wall pairs weighted by
-    ``implicit_walls`` (2 for mDBC, 1 for DBC walls)."""
-    velocity_gradient = viscous_correction or variable_viscosity
+    ``implicit_walls`` (2 for mDBC, 1 for DBC walls). ``strain_correction`` sums, over fluid
+    pairs, the Laplacian 2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate
+    g = ``f.gamma`` into LAPG and the support sum_b V_b (-F r^2) / 2 into SUPP (1 with a full
+    kernel, ``rheology.update_viscosity``)."""
+    velocity_gradient = viscous_correction or variable_viscosity or strain_correction
     implicit = implicit_walls > 0.0
-    DIAG = n_slots(shifting, shift_correction, viscous_correction, variable_viscosity)
+    DIAG = n_slots(shifting, shift_correction, viscous_correction, variable_viscosity,
+                   strain_correction=strain_correction)
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
     def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
@@ -290,6 +300,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
                             s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
                             s_diag = 0.0
+                            s_lapg = s_supp = 0.0
                             sxa = sza = 0.0
                             if shift_correction:
                                 sxa, sza = f.sdx[a], f.sdz[a]
@@ -391,6 +402,13 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     at[b, DUZ] -= Va * du * F * dz
                                     at[b, DWX] -= Va * dw * F * dx
                                     at[b, DWZ] -= Va * dw * F * dz
+                                if strain_correction:
+                                    if ka + kb == 0:
+                                        lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
+                                        s_lapg += Vb * lg
+                                        at[b, LAPG] -= Va * lg
+                                        s_supp -= 0.5 * Vb * rdotg
+                                        at[b, SUPP] -= 0.5 * Va * rdotg
                                 if shift_correction:
                                     # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
                                     e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
@@ -413,6 +431,9 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 at[a, VDIVR] += s_vdivr
                             if implicit:
                                 at[a, DIAG] += s_diag
+                            if strain_correction:
+                                at[a, LAPG] += s_lapg
+                                at[a, SUPP] += s_supp
                             if velocity_gradient:
                                 at[a, DUX] += s_dux
                                 at[a, DUZ] += s_duz

@@ -111,6 +111,8 @@ class Fluid:
     index: float = 1.0  # n
     max_viscosity: float | None = None  # mu_max [Pa s]: the regularisation's cap
     papanastasiou: float | None = None  # m [s]: tau_y (1 - exp(-m gamma)) / gamma below the cap
+    # remove the kernel smoothing's second-order error from the strain rate (solver/rheology.py)
+    strain_rate_correction: bool = False
 
     @property
     def newtonian(self) -> bool:
@@ -382,6 +384,8 @@ def _validate_rheology(scene: Scene) -> None:
         for key in ("consistency", "max_viscosity", "papanastasiou"):
             if getattr(f, key) is not None:
                 raise SceneError(f"fluid.{key}: only for rheology herschel_bulkley")
+        if f.strain_rate_correction:
+            raise SceneError("fluid.strain_rate_correction: only for rheology herschel_bulkley")
         if f.yield_stress != 0.0 or f.index != 1.0:
             raise SceneError("fluid.yield_stress, fluid.index: only for rheology herschel_bulkley")
         return

@@ -61,6 +61,7 @@ class Simulation:
         # each particle's kinematic viscosity (Herschel-Bulkley: from the last strain rate;
         # at rest the cap mu_max / rho0)
         self.nu_p = np.full(self.n, scene.nu)
+        self.gamma_p = np.zeros(self.n)  # the last strain rate (strain_rate_correction)
         self.nu_max_now = scene.nu
 
         s = scene
@@ -73,18 +74,21 @@ class Simulation:
         self.correct_shift = shifting_on and s.shift_density_correction
         self.viscous_correction = bool(s.physics.viscous_correction)
         self.variable_viscosity = not s.fluid.newtonian
+        self.strain_correction = self.variable_viscosity and bool(s.fluid.strain_rate_correction)
         self.implicit = s.physics.viscous_update == "implicit"
         self.mdbc = s.physics.boundary == "mdbc"
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
-                                 self.variable_viscosity, self.implicit)
+                                 self.variable_viscosity, self.implicit, self.strain_correction)
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
                                                 s.physics.density_diffusion_reference == "column",
                                                 self.viscous_correction,
                                                 bool(s.physics.artificial_viscosity),
                                                 self.variable_viscosity,
-                                                (2.0 if self.mdbc else 1.0) if self.implicit else 0.0)
+                                                (2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
+                                                self.strain_correction)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
-                              + (("nu_p",) if self.variable_viscosity else ()))
+                              + (("nu_p",) if self.variable_viscosity else ())
+                              + (("gamma_p",) if self.strain_correction else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
@@ -176,7 +180,8 @@ class Simulation:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
-                                   self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p)
+                                   self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
+                                   self.gamma_p)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
             # more pairs than the list holds: widen it and evaluate again
@@ -193,7 +198,8 @@ class Simulation:
             fl = s.fluid
             self.nu_max_now = rheology.update_viscosity(
                 self.out, self.kind, self.nu_p, self.n_active, self.rho0, fl.yield_stress,
-                fl.consistency, fl.index, fl.max_viscosity, fl.papanastasiou or 0.0)
+                fl.consistency, fl.index, fl.max_viscosity, fl.papanastasiou or 0.0, self.gamma_p,
+                rheology.SMOOTHING_KAPPA * self.h ** 2 if self.strain_correction else 0.0)
         if self.correct_shift:
             self._correct_density()
         return ""
@@ -308,7 +314,7 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFT + ("nu_p", "nu_max_now", "t", "steps", "info", "dt_first", "n_active",
+    _STATE = _SORTED + _SHIFT + ("nu_p", "gamma_p", "nu_max_now", "t", "steps", "info", "dt_first", "n_active",
                                  "reason")
 
     def state(self) -> dict:

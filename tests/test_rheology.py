@@ -118,3 +118,40 @@ def test_effective_viscosity_law():
         pap = rheology.effective_viscosity(g, tau_y, K, n, mu_max, 100.0)
         assert pap == pytest.approx(min(mu_max, tau_y * (1 - math.exp(-100 * g)) / g + K * g ** (n - 1)))
     assert rheology.effective_viscosity(0.0, tau_y, K, n, mu_max, 0.0) == mu_max
+
+
+def viscosity_error_on_the_exact_film(correction: bool, dp: float = 1.0e-3):
+    """mu_solver / mu(gamma_exact) - 1 of the particles in three bands of the yielded layer
+    (z/H 0.1-0.3, 0.3-0.45, 0.45-0.52; the yield surface is at 0.61 H), with the particles
+    given the exact Herschel-Bulkley film profile and the solver's viscosity evaluated twice
+    (the corrected strain rate uses the previous evaluation's Laplacian)."""
+    from solver.build import build_particles
+    sc = example_scene("hb_film", dp=dp, fluid={"strain_rate_correction": correction})
+    p = build_particles(sc)
+    f = sc.fluid
+    H, g = f.blocks[0].z[1], sc.gravity[0]
+    fl = p.kind == 0
+    p.u[fl] = exact.herschel_bulkley_film(p.z[fl], H, g, f.density, f.yield_stress, f.consistency, f.index)
+    p.rho[:] = f.density
+    sim = Simulation(sc, p)
+    sim._evaluate(0.0)
+    idx = np.flatnonzero(sim.kind[:sim.n_active] == 0)
+    z, mu = sim.z[idx], sim.nu_p[idx] * f.density
+    gamma = (np.maximum(f.density * g * (H - z) - f.yield_stress, 0.0) / f.consistency) ** (1 / f.index)
+    mu_exact = np.array([rheology.effective_viscosity(gm, f.yield_stress, f.consistency, f.index,
+                                                      f.max_viscosity, 0.0) for gm in gamma])
+    return [mu[(z > lo * H) & (z < hi * H)] / mu_exact[(z > lo * H) & (z < hi * H)] - 1
+            for lo, hi in ((0.1, 0.3), (0.3, 0.45), (0.45, 0.52))]
+
+
+@pytest.mark.slow
+def test_the_strain_rate_correction_removes_the_smoothing_bias_of_the_viscosity():
+    """The exact film's strain rate, proportional to (h0 - z)^(1/n) = (h0 - z)^2.5, is convex,
+    so its kernel average is too high and the viscosity too low: at dp = 1 mm the band means are -1.9, -4.9 and -12.4 %
+    (measured). With fluid.strain_rate_correction (gamma - 5/36 h^2 lap gamma) they are -0.5,
+    -0.5 and -0.9 %, every particle within 0.75 %, 0.57 % and 0.93 %."""
+    plain = viscosity_error_on_the_exact_film(False)
+    corrected = viscosity_error_on_the_exact_film(True)
+    assert np.mean(plain[1]) < -0.03 and np.mean(plain[2]) < -0.08
+    for band in corrected:
+        assert np.abs(band).max() < 0.012, np.abs(band).max()
