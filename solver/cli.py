@@ -159,7 +159,9 @@ def _warm(args) -> int:
             d["start"] = "lubrication"
         case = case_from_dict(d)
         coarse = case_from_dict({**d, "dp": max(case.dp, case.h_n / 5)})
-        key = json.dumps(build_scene(coarse).to_dict()["physics"], sort_keys=True) + case.rheology
+        scene = build_scene(coarse).to_dict()
+        fluid = {k: v for k, v in scene["fluid"].items() if k not in ("blocks", "profiles")}
+        key = json.dumps([scene["physics"], fluid], sort_keys=True)  # what selects the kernels
         if key not in seen:
             seen.add(key)
             step_twice(coarse)

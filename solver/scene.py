@@ -22,13 +22,6 @@ LIND_MIN_CH = 1.1  # below it Lind shifting fails on the conveyor case (docs/num
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
 
 
-def implicit_bytes_per_particle(ch: float) -> float:
-    """What the implicit viscous update adds (solver/implicit.py): the pair list (16 B a pair)
-    and its arrangement by rows (24 B a pair), 0.75 pi (2 Ch)^2 pairs a particle as
-    allocated, and 14 numbers of scratch and row offsets (2 threads); 1.3 kB at Ch = 1.8."""
-    return 0.75 * math.pi * (2.0 * ch) ** 2 * 40.0 + 112.0
-
-
 class SceneError(ValueError):
     """A scene value is missing, of the wrong type or physically impossible."""
 
@@ -518,8 +511,10 @@ def validate(scene: Scene) -> None:
         _interval(scene.domain.x, "domain.x")
         _interval(scene.domain.z, "domain.z")
     n = scene.estimated_particles()
-    per_particle = BYTES_PER_PARTICLE + (implicit_bytes_per_particle(scene.ch)
-                                         if scene.physics.viscous_update == "implicit" else 0.0)
+    per_particle = BYTES_PER_PARTICLE
+    if scene.physics.viscous_update == "implicit":
+        from .implicit import bytes_per_particle
+        per_particle += bytes_per_particle(scene.ch)
     need = n * per_particle / 1e9
     if need > scene.memory_budget_gb:
         raise SceneError(

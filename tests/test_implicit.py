@@ -164,12 +164,11 @@ def test_a_pair_list_that_overflows_is_widened_and_the_evaluation_repeated():
 
 
 def test_the_memory_estimate_covers_what_the_implicit_update_allocates():
-    """scene.implicit_bytes_per_particle against the arrays' own sizes (plus the fixed
-    1024 pairs of slack per thread)."""
-    from solver.scene import implicit_bytes_per_particle
+    """implicit.bytes_per_particle, which the scene's memory check adds, against the arrays'
+    own sizes (plus the fixed 1024 pairs of slack per thread)."""
     sc, sim = jittered_couette()
     held = (sum(a.nbytes for a in sim.pairs) + sum(a.nbytes for a in sim.rows)
             + sim.solver_work.nbytes)
     slack = sim.nthreads * 1024 * 40
-    assert held <= sim.n * implicit_bytes_per_particle(sc.ch) + slack + 64
-    assert held >= 0.9 * sim.n * implicit_bytes_per_particle(sc.ch)
+    assert held <= sim.n * implicit.bytes_per_particle(sc.ch) + slack + 64
+    assert held >= 0.9 * sim.n * implicit.bytes_per_particle(sc.ch)
