@@ -61,7 +61,6 @@ class Simulation:
         # each particle's kinematic viscosity (Herschel-Bulkley: from the last strain rate;
         # at rest the cap mu_max / rho0)
         self.nu_p = np.full(self.n, scene.nu)
-        self.gamma_p = np.zeros(self.n)  # the last strain rate (strain_rate_correction)
         self.nu_max_now = scene.nu
 
         s = scene
@@ -75,6 +74,8 @@ class Simulation:
         self.viscous_correction = bool(s.physics.viscous_correction)
         self.variable_viscosity = not s.fluid.newtonian
         self.strain_correction = self.variable_viscosity and bool(s.fluid.strain_rate_correction)
+        # the last strain rate (strain_rate_correction; a placeholder otherwise)
+        self.gamma_p = np.zeros(self.n if self.strain_correction else 1)
         self.implicit = s.physics.viscous_update == "implicit"
         self.mdbc = s.physics.boundary == "mdbc"
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
