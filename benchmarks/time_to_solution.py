@@ -36,6 +36,9 @@ VARIANTS = {
     "average_1s": ["steady.average=1.0"],
     "cfl_0.3": ["cfl=0.3"],
     "cfl_0.3_average_1s": ["cfl=0.3", "steady.average=1.0"],
+    # examples/conveyor_fast.yaml: the consistent laminar term, the film profile as initial
+    # velocity, C 0.4 on the acoustic limit and 0.2 on the viscous one
+    "fast": ["viscous_correction=true", "start_velocity=lubrication", "cfl=0.4", "cfl_viscous=0.2"],
 }
 
 

@@ -4,6 +4,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -58,6 +59,25 @@ def test_preset_geometry(start):
     assert p.x[f].max() < initial_toe(c)
     if start == "block":
         assert p.z[f].max() == pytest.approx(c.dp * (round(c.h_n / c.dp) - 0.5), abs=1e-12)
+
+
+def test_fast_example_is_the_paper_case_with_its_documented_settings():
+    """examples/conveyor_fast.yaml differs from conveyor.yaml only in the settings that
+    docs/conveyor.md measures ("A steady answer in two minutes"), and builds a valid scene."""
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        paper_d = yaml.safe_load(fh)
+    with open(EXAMPLES / "conveyor_fast.yaml") as fh:
+        fast_d = yaml.safe_load(fh)
+    changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
+    assert changed == {"name", "shifting", "viscous_correction", "start_velocity", "cfl",
+                       "cfl_viscous", "steady"}
+    assert {k: v for k, v in fast_d["steady"].items() if k != "max_time"} == \
+        {k: v for k, v in paper_d["steady"].items() if k != "max_time"}
+    fast = case_from_dict(fast_d)
+    assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
+    assert (fast.cfl, fast.cfl_viscous) == (0.4, 0.2)
+    assert fast.h_n == paper().h_n
+    build_scene(replace(fast, dp=4.0e-3, ch=1.5))
 
 
 def test_case_errors_name_the_key():
