@@ -1,13 +1,14 @@
 """Where a front run's fluid is loosely packed: the final particle state of a front run
 (NetCDF from `python -m solver front`) by distance from the toe.
 
-Per band of 1 h_n in x* = (x_toe - x) / h_n it prints the kernel number density
-C = sum_b dp^2 W_ab (fluid and wall particles; 1 on a lattice, below 1 where particles stand
-further apart than their lattice cell) in four height bands z / eta (eta the run's last
-free-surface sample) and in the interior (more than 2h from bed and surface), and the mean
-rho / rho0 and pressure. In continuity-density SPH the density does not follow the spacing,
-so C < 1 at rho ~ rho0 is volume that the fluid takes without mass: the "inflation" of the
-volume budget (docs/numerics.md, "Where the volume goes").
+Per band of 1 h_n in x* = (x_toe - x) / h_n it prints, at the fluid particles, the kernel
+concentration C = sum_b (m_b / rho_b) W_ab over fluid and wall particles (the free-surface
+probe's C, solver/probes.py; 1 where the particles' own volumes fill the space, as on a
+lattice) in four height bands z / eta (eta the run's last free-surface sample) and in the
+interior (more than 2h from bed and surface), and the mean rho / rho0 and pressure. In
+continuity-density SPH the density does not follow the spacing, so C < 1 at rho ~ rho0 is
+room the fluid takes without mass: the "inflation" of the volume budget (docs/numerics.md,
+"Where the volume goes").
 
     python benchmarks/front_structure.py results/front.nc [--bands 15]
 """
@@ -23,46 +24,44 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from solver.kernel import kernel  # noqa: E402
-from solver.probes import toe_position  # noqa: E402
+from solver import cells  # noqa: E402
+from solver.build import build_particles  # noqa: E402
+from solver.conveyor import build_scene, case_from_dict  # noqa: E402
+from solver.probes import sample_points, toe_position  # noqa: E402
 
 HEIGHTS = ((0.0, 0.25), (0.25, 0.5), (0.5, 0.75), (0.75, 9.0))
 
 
-def number_density(x, z, targets, dp: float, h: float) -> np.ndarray:
-    """C_a = sum_b dp^2 W(|r_a - r_b|) over all particles b, for the particles ``targets``."""
-    cs = 2.0 * h
-    ix = np.floor((x - x.min()) / cs).astype(np.int64)
-    iz = np.floor((z - z.min()) / cs).astype(np.int64)
-    stride = int(iz.max()) + 3
-    key = ix * stride + iz
-    order = np.argsort(key)
-    ks = key[order]
-    out = np.zeros(targets.size)
-    for di in (-1, 0, 1):
-        for dj in (-1, 0, 1):
-            kk = (ix[targets] + di) * stride + iz[targets] + dj
-            lo = np.searchsorted(ks, kk, "left")
-            hi = np.searchsorted(ks, kk, "right")
-            for n, a in enumerate(targets):
-                b = order[lo[n]:hi[n]]
-                r = np.hypot(x[b] - x[a], z[b] - z[a])
-                out[n] += dp * dp * kernel(r[r < 2.0 * h], h).sum()
-    return out
+def concentration(x, z, u, w, rho, mass, kind, h: float) -> np.ndarray:
+    """C = sum_b (m_b / rho_b) W_ab (fluid and walls) at every fluid particle, by the probes'
+    sampler on a cell list of the given particles."""
+    grid = cells.Grid.cover(x.min() - h, x.max() + h, z.min() - h, z.max() + h, 2.0 * h, False)
+    start = np.zeros(grid.ncells + 2, dtype=np.int64)
+    cl = grid.cell_list(start)
+    cell = np.zeros(x.size, dtype=np.int64)
+    order = np.zeros(x.size, dtype=np.int64)
+    cells.assign_cells(x, z, kind, cl, cell)
+    cells.counting_sort(cell, grid.ncells + 1, order, start)
+    f = kind == 0
+    out = np.empty((5, int(f.sum())))
+    sample_points(np.ascontiguousarray(x[f]), np.ascontiguousarray(z[f]),
+                  *(np.ascontiguousarray(a[order]) for a in (x, z, u, w, rho, mass, kind)), cl, h, out)
+    return out[0]
 
 
 def structure(ds: xr.Dataset, bands: int) -> list[dict]:
-    case = yaml.safe_load(ds.attrs["case_yaml"])
-    dp = float(case["dp"])
-    h = float(case.get("ch", 1.8)) * dp
-    hn = float(ds.attrs["h_n_m"])
-    rho0 = float(case.get("density", 1383.0))
+    case = case_from_dict(yaml.safe_load(ds.attrs["case_yaml"]))
+    dp, h, hn = case.dp, case.ch * case.dp, float(ds.attrs["h_n_m"])
+    rho0 = case.density
+    mass = build_particles(build_scene(case)).mass  # rho(t=0) dp^2, in snapshot order
     s = ds.isel(snapshot=-1)
+    if s.x.size != mass.size:
+        raise ValueError(f"the snapshot holds {s.x.size} particles, the case builds {mass.size}")
     ok = np.isfinite(s.x.values)
-    x, z, kind = s.x.values[ok], s.z.values[ok], s.kind.values[ok]
-    rho, p = s.rho.values[ok], s.p.values[ok]
+    x, z, u, w = (s[k].values[ok] for k in ("x", "z", "u", "w"))
+    rho, p, kind, mass = s.rho.values[ok], s.p.values[ok], s.kind.values[ok], mass[ok]
+    c = concentration(x, z, u, w, rho, mass, kind, h)
     fluid = np.where(kind == 0)[0]
-    c = number_density(x, z, fluid, dp, h)
     xf, zf = x[fluid], z[fluid]
     xs = (toe_position(xf, dp) - xf) / hn
     eta = np.interp(xs, ds.x_star.values, ds.surface_elevation.values[-1])
