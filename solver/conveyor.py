@@ -88,6 +88,7 @@ class ConveyorCase(YamlData):
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False
+    volume_relaxation: float | None = None
     viscous_update: str = "explicit"  # or implicit: no viscous limit on dt (docs/numerics.md)
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
@@ -304,6 +305,7 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
                     "density_diffusion": c.density_diffusion,
                     "density_diffusion_reference": c.density_diffusion_reference,
                     "viscous_correction": c.viscous_correction,
+                    "volume_relaxation": c.volume_relaxation,
                     "viscous_update": c.viscous_update, "shifting": shifting},
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},

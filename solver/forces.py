@@ -38,7 +38,7 @@ from typing import NamedTuple
 import numba as nb
 import numpy as np
 
-from .kernel import grad_coefficient, grad_factor
+from .kernel import alpha_2d, grad_coefficient, grad_factor, w_value
 
 # Accumulator slots of the pair loop, acc[thread, particle, slot]
 AX, AZ, DRHO = 0, 1, 2                # acceleration, drho/dt
@@ -50,19 +50,29 @@ VGX, VGZ, DUX, DUZ, DWX, DWZ, VDIVR = 9, 10, 11, 12, 13, 14, 15
 NQ_BASE, NQ_SHIFT, NQ_CORRECTED, NQ_VISCOUS = 3, 8, 9, 16
 # corrected strain rate: the Laplacian of the last strain rate, and the support sum_b V_b (-F r^2) / 2
 LAPG, SUPP, NQ_STRAIN = 16, 17, 18
-# implicit viscosity: the diagonal sum_b c_ab of the backward-Euler system goes in the last slot
+# volume relaxation: the concentration sum_b V_b W_ab (without the self term) in the slot after
+# the others (``volume_slot``); implicit viscosity: the diagonal sum_b c_ab of the backward-Euler
+# system in the last slot
 
 
 def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
             velocity_gradient: bool = False, implicit: bool = False,
-            strain_correction: bool = False) -> int:
+            strain_correction: bool = False, volume: bool = False) -> int:
+    nq = volume_slot(shifting, shift_correction, viscous_correction, velocity_gradient,
+                     strain_correction) + (1 if volume else 0)
+    return nq + 1 if implicit else nq
+
+
+def volume_slot(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
+                velocity_gradient: bool = False, strain_correction: bool = False) -> int:
+    """The slot after the named ones: the volume relaxation's concentration when it is on."""
     if strain_correction:
         nq = NQ_STRAIN
     elif viscous_correction or velocity_gradient:
         nq = NQ_VISCOUS
     else:
         nq = NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
-    return nq + 1 if implicit else nq
+    return nq
 
 
 class PairList(NamedTuple):
@@ -227,7 +237,8 @@ def concentration_terms(dp2, F, dx, dz, rdotg):
 def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
                    column_reference: bool = False, viscous_correction: bool = False,
                    artificial: bool = False, variable_viscosity: bool = False,
-                   implicit_walls: float = 0.0, strain_correction: bool = False):
+                   implicit_walls: float = 0.0, strain_correction: bool = False,
+                   volume: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
     divergence (for the density correction) in or out; ``column_reference`` picks the
     diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
@@ -240,11 +251,13 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     ``implicit_walls`` (2 for mDBC, 1 for DBC walls). ``strain_correction`` sums, over fluid
     pairs, the Laplacian 2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate
     g = ``f.gamma`` into LAPG and the support sum_b V_b (-F r^2) / 2 into SUPP (1 with a full
-    kernel, ``rheology.update_viscosity``)."""
+    kernel, ``rheology.update_viscosity``). ``volume`` sums the concentration sum_b V_b W_ab
+    (every pair with a fluid particle) into slot ``volume_slot(...)``, for ``relax_density``."""
     velocity_gradient = viscous_correction or variable_viscosity or strain_correction
     implicit = implicit_walls > 0.0
-    DIAG = n_slots(shifting, shift_correction, viscous_correction, variable_viscosity,
-                   strain_correction=strain_correction)
+    VOLC = volume_slot(shifting, shift_correction, viscous_correction, variable_viscosity,
+                       strain_correction)
+    DIAG = VOLC + 1 if volume else VOLC
 
     @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
     def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
@@ -258,6 +271,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         nt = split.size - 1
         fac = grad_coefficient(h)
         eta2 = 0.01 * h * h
+        alpha = alpha_2d(h)
         four_h2 = 4.0 * h * h
         inv_h = 1.0 / h
         for t in nb.prange(nt):
@@ -301,6 +315,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
                             s_diag = 0.0
                             s_lapg = s_supp = 0.0
+                            s_volc = 0.0
                             sxa = sza = 0.0
                             if shift_correction:
                                 sxa, sza = f.sdx[a], f.sdz[a]
@@ -314,7 +329,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 r2 = dx * dx + dz * dz
                                 if r2 >= four_h2:
                                     continue
-                                F = grad_factor(math.sqrt(r2) * inv_h, fac)
+                                q = math.sqrt(r2) * inv_h
+                                F = grad_factor(q, fac)
                                 rb = rho[b]
                                 du = ua - u[b]
                                 dw = wa - w[b]
@@ -409,6 +425,10 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                         at[b, LAPG] -= Va * lg
                                         s_supp -= 0.5 * Vb * rdotg
                                         at[b, SUPP] -= 0.5 * Va * rdotg
+                                if volume:
+                                    Wab = w_value(q, alpha)
+                                    s_volc += Vb * Wab
+                                    at[b, VOLC] += Va * Wab
                                 if shift_correction:
                                     # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
                                     e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
@@ -429,6 +449,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 at[a, VGX] += s_vgx
                                 at[a, VGZ] += s_vgz
                                 at[a, VDIVR] += s_vdivr
+                            if volume:
+                                at[a, VOLC] += s_volc
                             if implicit:
                                 at[a, DIAG] += s_diag
                             if strain_correction:

@@ -154,6 +154,9 @@ class Physics:
     density_diffusion_reference: str = "spec"
     # remove the laminar term's first-order error 2 nu G . grad u where the support is full
     viscous_correction: bool = False
+    # beta: interior density relaxes towards the particles' packing at a rate beta c0 / h
+    # (solver/packing.py); null: off
+    volume_relaxation: float | None = None
     # explicit (SPEC: the laminar term at v^n, dt bounded by h^2 / nu) or implicit (backward
     # Euler in the laminar term, no viscous limit on dt: solver/implicit.py)
     viscous_update: str = "explicit"
@@ -446,6 +449,13 @@ def validate(scene: Scene) -> None:
         raise SceneError(f"physics.density_diffusion_reference: {ph.density_diffusion_reference!r} "
                          f"is not one of {', '.join(DIFFUSION_REFERENCES)}")
     sh = ph.shifting
+    if ph.volume_relaxation is not None:
+        if not ph.volume_relaxation > 0:
+            raise SceneError("physics.volume_relaxation: a rate beta > 0 (0.1 measured, "
+                             f"docs/numerics.md) or null, got {ph.volume_relaxation!r}")
+        if sh.method == "none":
+            raise SceneError("physics.volume_relaxation: needs shifting (skillen or lind): it "
+                             "finds the interior by the shifting's concentration gradient")
     if sh.method not in SHIFTING_METHODS:
         raise SceneError(
             f"physics.shifting.method: {sh.method!r} is not one of {', '.join(SHIFTING_METHODS)}")

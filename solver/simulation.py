@@ -6,8 +6,9 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from . import boundary, cells, forces, guards, implicit, integrate, rheology, shifting
+from . import boundary, cells, forces, guards, implicit, integrate, packing, rheology, shifting
 from .build import Particles, build_particles
+from .kernel import alpha_2d
 from .scene import Scene
 
 _SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "wnx", "wnz",
@@ -77,16 +78,18 @@ class Simulation:
         # the last strain rate (strain_rate_correction; a placeholder otherwise)
         self.gamma_p = np.zeros(self.n if self.strain_correction else 1)
         self.implicit = s.physics.viscous_update == "implicit"
+        self.volume_relaxation = s.physics.volume_relaxation or 0.0
         self.mdbc = s.physics.boundary == "mdbc"
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
-                                 self.variable_viscosity, self.implicit, self.strain_correction)
+                                 self.variable_viscosity, self.implicit, self.strain_correction,
+                                 self.volume_relaxation > 0)
         self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
                                                 s.physics.density_diffusion_reference == "column",
                                                 self.viscous_correction,
                                                 bool(s.physics.artificial_viscosity),
                                                 self.variable_viscosity,
                                                 (2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
-                                                self.strain_correction)
+                                                self.strain_correction, self.volume_relaxation > 0)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ()))
@@ -231,6 +234,14 @@ class Simulation:
         self.shift_dx[:] = 0.0
         self.shift_dz[:] = 0.0
 
+    def _relax_volume(self, dt: float):
+        """The interior density towards the particles' packing (``packing.relax_density``)."""
+        vol = forces.volume_slot(True, self.correct_shift, self.viscous_correction,
+                                 self.variable_viscosity, self.strain_correction)
+        packing.relax_density(self.rho, self.mass, self.kind, self.out[vol], self.out[forces.GCX],
+                              self.out[forces.GCZ], self.n_active, alpha_2d(self.h), self.h,
+                              self.n_lattice, self.volume_relaxation * self.c0 * dt / self.h)
+
     def _update_dt(self):
         dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0,
                                          self.nu_max_now, self.scene.cfl_viscous,
@@ -283,6 +294,8 @@ class Simulation:
             reason = self._solve_viscous(dt)
         if reason:
             return self._stop(reason)
+        if self.volume_relaxation:
+            self._relax_volume(dt)
         o = self.out
         integrate.kick(self.u, self.w, self.rho, self.kind, o[forces.AX], o[forces.AZ], o[forces.DRHO],
                        self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc,
