@@ -70,12 +70,13 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
     assert changed == {"name", "shifting", "viscous_correction", "start_velocity", "cfl",
-                       "cfl_viscous", "steady"}
+                       "cfl_viscous", "volume_relaxation", "density_diffusion_reference", "steady"}
     assert {k: v for k, v in fast_d["steady"].items() if k != "max_time"} == \
         {k: v for k, v in paper_d["steady"].items() if k != "max_time"}
     fast = case_from_dict(fast_d)
     assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
     assert (fast.cfl, fast.cfl_viscous) == (0.4, 0.2)
+    assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
     assert fast.h_n == paper().h_n
     build_scene(replace(fast, dp=4.0e-3, ch=1.5))
 
