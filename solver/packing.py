@@ -25,8 +25,9 @@ import math
 import numba as nb
 
 LIMIT = 1.0e-3  # largest relative density change per step
-GRAD_MAX = 0.05  # h |gradC| below which a particle counts as interior (the tank's row 1.5 dp under its
-# surface, next to a wall: 0.09)
+# h |gradC| below which a particle counts as interior (the tank's row 1.5 dp under its
+# surface, next to a side wall, has 0.09)
+GRAD_MAX = 0.05
 
 
 @nb.njit(parallel=True, cache=True)

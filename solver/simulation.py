@@ -79,6 +79,9 @@ class Simulation:
         self.gamma_p = np.zeros(self.n if self.strain_correction else 1)
         self.implicit = s.physics.viscous_update == "implicit"
         self.volume_relaxation = s.physics.volume_relaxation or 0.0
+        # its concentration's slot (the option needs shifting)
+        self.volume_slot = forces.volume_slot(True, self.correct_shift, self.viscous_correction,
+                                              self.variable_viscosity, self.strain_correction)
         self.mdbc = s.physics.boundary == "mdbc"
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
                                  self.variable_viscosity, self.implicit, self.strain_correction,
@@ -236,10 +239,9 @@ class Simulation:
 
     def _relax_volume(self, dt: float):
         """The interior density towards the particles' packing (``packing.relax_density``)."""
-        vol = forces.volume_slot(True, self.correct_shift, self.viscous_correction,
-                                 self.variable_viscosity, self.strain_correction)
-        packing.relax_density(self.rho, self.mass, self.kind, self.out[vol], self.out[forces.GCX],
-                              self.out[forces.GCZ], self.n_active, alpha_2d(self.h), self.h,
+        packing.relax_density(self.rho, self.mass, self.kind, self.out[self.volume_slot],
+                              self.out[forces.GCX], self.out[forces.GCZ], self.n_active,
+                              alpha_2d(self.h), self.h,
                               self.n_lattice, self.volume_relaxation * self.c0 * dt / self.h)
 
     def _update_dt(self):

@@ -3,7 +3,7 @@ for interior fluid particles, C_a = sum_b (m_b / rho_b) W_ab."""
 import numpy as np
 import pytest
 
-from solver import forces, packing
+from solver import packing
 from solver.build import build_particles
 from solver.scene import SceneError
 from solver.simulation import Simulation
@@ -30,8 +30,7 @@ def relaxed_change(sim: Simulation) -> np.ndarray:
 
 
 def concentration(sim: Simulation) -> np.ndarray:
-    vol = forces.volume_slot(True, sim.correct_shift)
-    return sim.out[vol] + sim.mass / sim.rho * 7.0 / (4.0 * np.pi * sim.h ** 2)
+    return sim.out[sim.volume_slot] + sim.mass / sim.rho * 7.0 / (4.0 * np.pi * sim.h ** 2)
 
 
 def test_a_lattice_is_at_the_lattice_concentration_and_is_left_alone():
