@@ -132,22 +132,37 @@ class FrontMonitor:
                 "surface": surface, "velocity": u_star}
 
     def why_not_steady(self) -> str:
-        """Which signals fail their tolerance over the final window, by how much, and which
-        detections were withdrawn."""
+        """Which signals fail their tolerance, by how much, over the trailing span (of
+        steady.SPANS) closest to passing, and which detections were withdrawn."""
         t = np.asarray(self.t)
         if t.size < 3:
             return "too few probe samples"
-        r = steady.assess(t, self.series["front_position"], self.series["uniform_depth"],
-                          self.station_means(), self.tracker.crit, self.case.belt.speed, self.case.h_n,
-                          t_start=t[-1] - self.case.steady.average)["ratio"]
+        # the trailing span (of those detection tries) that came closest to passing
+        crit = self.tracker.crit
+        best = None
+        for k in steady.SPANS:
+            span = k * crit.window
+            if k > 1 and t[-1] - span < max(crit.min_time, t[0]) - 1e-9:
+                break
+            r = steady.assess(t, self.series["front_position"], self.series["uniform_depth"],
+                              self.station_means(), crit, self.case.belt.speed, self.case.h_n,
+                              t_start=t[-1] - span)["ratio"]
+            worst = max((v if np.isfinite(v) else math.inf) for v in r.values())
+            if best is None or worst < best[0]:
+                best = (worst, span, r)
+        _, span, r = best
         names = {"front": "front position", "depth": "uniform depth", "velocity": "station velocity"}
         failing = [f"{names[k]} {v:.1f}x" for k, v in r.items() if not (np.isfinite(v) and v <= 1.0)]
-        text = ("over the final window, drift bound / tolerance: " + ", ".join(failing)) if failing else \
-            "the final window meets the tolerances but steady state was detected too late to average"
+        text = (f"over the final {span:g} s, drift bound / tolerance: " + ", ".join(failing)) if failing else \
+            f"the final {span:g} s meet the tolerances"
+        t_s = self.tracker.t_steady
+        if np.isfinite(t_s):
+            text += (f"; steady state detected at {t_s:.2f} s, but its averaging window ({t[-1] - t_s:.2f} s "
+                     "by max_time) had not yet met the tolerances")
         withdrawn = [a for a, _ in self.tracker.rejected]
         if withdrawn:
             text += (f"; detections at {', '.join(f'{v:.2f}' for v in withdrawn)} s withdrawn "
-                     "(their averaging windows drifted)")
+                     "(their averaging windows drifted or stayed too noisy)")
         return text
 
     def station_means(self) -> np.ndarray:
@@ -236,15 +251,18 @@ class FrontMonitor:
         ds["film_slip"] = (("time",), slip, {
             "units": "1",
             "long_name": f"u* at the bed of the fitted profile at x* = {self.stations[far]:g} (0: no slip)"})
-        # the averaging window: with steady.stop, the window after detection, steady when the
-        # tracker verified it; otherwise (fixed end time, or no steady state) the final window
+        # the averaging window: with steady.stop, the window after detection (steady.average,
+        # or longer where the tracker extended a noisy window), steady when the tracker
+        # verified it; otherwise (fixed end time, or no steady state) the final window
         # of the same length, steady only when steady state was detected before it starts and
         # the window itself meets the tolerances; a window that is not steady is flagged
         # (attrs steady = 0, averaging) so that nothing passes for a steady result
         final = t[-1] - c.steady.average if t.size else np.nan
+        end = t[-1] if t.size else np.nan
         if c.steady.stop:
             steady_found = self.state == "steady"
             start = self.t_steady if steady_found else final
+            end = self.tracker.t_end if steady_found else end
         else:
             start = final
             steady_found = bool(np.isfinite(self.t_steady) and self.t_steady <= final + 1e-9
@@ -256,7 +274,7 @@ class FrontMonitor:
         ds.attrs["steady_withdrawn_s"] = [float(a) for a, _ in self.tracker.rejected] or ""
         ds.attrs["averaging"] = "steady window" if steady_found else "final window, NOT steady"
         if t.size and t[-1] - t[0] >= c.steady.average - 1e-9:
-            win = (t >= start - 1e-9) & (t <= start + c.steady.average + 1e-9)
+            win = (t >= start - 1e-9) & (t <= end + 1e-9)
             tw = t[win]
             avg = ds.isel(time=win).mean("time")
             for k in ("surface_elevation", "velocity_star", "uniform_depth", "number_density", "area_drift"):

@@ -10,6 +10,13 @@ is weighed against the signal's own sampling noise: noise alone lengthens the ti
 detection, never shortens it, and a drift larger than the tolerance never passes however
 noisy the signal.
 
+Verification: once detected at t_s, the averaging window [t_s, t_s + average] must itself
+meet the tolerances (1 se: the detection was already confident). A window that fails there
+without a confident drift (every signal's lower bound |slope| - 2 se within its tolerance)
+is too noisy to judge, not drifting: it is extended, and the longer window must then pass
+at 2 se, up to the longest detection span (SPANS[-1] windows). A confident drift at the
+nominal end, or a window that reaches that length without passing, withdraws the detection.
+
 Tolerances (the probes of a coarse run fluctuate by a fraction of dp, so a tolerance fixed
 in h_n or u_b alone cannot be met at every dp):
   front:    drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
@@ -102,30 +109,36 @@ def assess(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: fl
     trailing ``crit.window``). Drift bounds are scaled to the span of ``crit.window``, so a
     longer span (an averaging window) is judged by the same rates.
 
-    Returns {"steady": bool, "ratio": {signal: bound / tolerance}} (ratio <= 1 passes)."""
+    Returns {"steady": bool, "ratio": {signal: upper bound / tolerance} (ratio <= 1
+    passes), "lower": {signal: (|slope| - Z se) * window / tolerance} (> 1: a confident
+    drift beyond the tolerance)}."""
     t = np.asarray(t, dtype=float)
     start = t[-1] - crit.window if t_start is None else t_start
     m = (t >= start - 1e-12)
     tol = tolerances(crit, u_b, h_n)
-    ratio = {}
-    for name, y in (("front", front), ("depth", depth)):
-        s, se = trend_bound(t[m], np.asarray(y, dtype=float)[m])
-        ratio[name] = (abs(s) + z * se) * crit.window / tol[name]
     su = np.asarray(station_u, dtype=float).reshape(len(t), -1)[m]
-    worst = 0.0
-    for j in range(su.shape[1]):
-        s, se = trend_bound(t[m], su[:, j])
-        worst = max(worst, (abs(s) + z * se) * crit.window / tol["velocity"]) if np.isfinite(s) else math.nan
-    ratio["velocity"] = worst
+    signals = {"front": [np.asarray(front, dtype=float)[m]], "depth": [np.asarray(depth, dtype=float)[m]],
+               "velocity": [su[:, j] for j in range(su.shape[1])]}
+    ratio, lower = {}, {}
+    for name, ys in signals.items():
+        up = low = 0.0
+        for y in ys:
+            s, se = trend_bound(t[m], y)
+            if not np.isfinite(s):
+                up = low = math.nan
+                break
+            up = max(up, (abs(s) + z * se) * crit.window / tol[name])
+            low = max(low, (abs(s) - Z * se) * crit.window / tol[name])
+        ratio[name], lower[name] = up, low
     ok = all(np.isfinite(v) and v <= 1.0 for v in ratio.values())
-    return {"steady": bool(ok), "ratio": ratio}
+    return {"steady": bool(ok), "ratio": ratio, "lower": lower}
 
 
-SPANS = (1, 2, 4)  # trailing spans tried, in windows: a longer span resolves a noisier trend
+SPANS = (1, 2, 4, 8)  # trailing spans tried, in windows: a longer span resolves a noisier trend
 
 
 def is_steady(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
-    """True when a trailing span of 1, 2 or 4 windows, after ``crit.min_time``, meets every
+    """True when a trailing span of SPANS windows, after ``crit.min_time``, meets every
     tolerance with confidence. A noisy signal needs a longer span to show that its drift
     is small; a real drift fails on every span."""
     t = np.asarray(t, dtype=float)
@@ -146,14 +159,21 @@ class SteadyTracker:
 
     ``update`` takes the probe series so far. Once ``is_steady`` fires at t_s the run
     averages over [t_s, t_s + average]; when that window is complete it must itself meet
-    the tolerances (``assess`` from t_s), or the detection is withdrawn (recorded in
-    ``rejected``) and detection starts again. States: "transient", "averaging", "steady".
+    the tolerances (``judge_window``). A window too noisy to judge is extended (``t_end``
+    moves on); a drifting one is withdrawn (recorded in ``rejected``) and detection starts
+    again. States: "transient", "averaging", "steady". A steady window is [t_steady, t_end].
     """
 
     def __init__(self, crit: SteadyCriteria, u_b: float, h_n: float, average: float):
         self.crit, self.u_b, self.h_n, self.average = crit, u_b, h_n, average
         self.t_steady = math.nan
+        self.t_end = math.nan  # end of the verified averaging window
         self.rejected: list[tuple[float, float]] = []  # (detected at, withdrawn at)
+
+    @property
+    def max_average(self) -> float:
+        """The longest an averaging window may be extended to."""
+        return max(self.average, SPANS[-1] * self.crit.window)
 
     def update(self, t, front, depth, station_u) -> str:
         t_end = float(np.asarray(t)[-1])
@@ -164,13 +184,32 @@ class SteadyTracker:
             return "transient"
         if t_end < self.t_steady + self.average - 1e-9:
             return "averaging"
-        if self.verify(t, front, depth, station_u, self.t_steady):
+        verdict = self.judge_window(t, front, depth, station_u, self.t_steady)
+        if verdict == "steady":
+            self.t_end = t_end
             return "steady"
+        if verdict != "drift" and t_end < self.t_steady + self.max_average - 1e-9:
+            return "averaging"  # too noisy to judge yet: the window is extended
         self.rejected.append((self.t_steady, t_end))
         self.t_steady = math.nan
         return "transient"
 
+    def judge_window(self, t, front, depth, station_u, t_start: float) -> str:
+        """The averaging window from t_start to the last sample: "steady" when it meets the
+        tolerances (the nominal window at 1 se, an extended one at 2 se); otherwise, at the
+        nominal end, "drift" when a signal's drift exceeds its tolerance with confidence
+        (lower bound |slope| - 2 se) and "noisy" when none does; past it, "extended"."""
+        t = np.asarray(t, dtype=float)
+        extended = t.size > 1 and t[-2] >= t_start + self.average - 1e-9  # past its nominal end
+        r = assess(t, front, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
+                   z=Z if extended else VERIFY_Z)
+        if r["steady"]:
+            return "steady"
+        if extended:
+            return "extended"
+        return "noisy" if all(np.isfinite(v) and v <= 1.0 for v in r["lower"].values()) else "drift"
+
     def verify(self, t, front, depth, station_u, t_start: float) -> bool:
-        """Whether the samples from t_start on meet the tolerances (a fixed-end window)."""
+        """Whether the samples from t_start on meet the tolerances (a fixed-end window, 1 se)."""
         return assess(t, front, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
                       z=VERIFY_Z)["steady"]

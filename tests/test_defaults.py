@@ -2,7 +2,7 @@
 campaign schema holds the campaign's own. What repeats them must agree:
 - the schema's defaults of the keys every solver case also takes (study.config.SOLVER_KEYS);
 - the table of case keys in docs/conveyor.md (every key documented, every default as coded);
-- config/config.yaml, config/stability.yaml and config/settled.yaml set only what differs from a default;
+- config/config.yaml and config/stability.yaml set only what differs from a default;
 - config/paper.yaml pins the paper's physical case, which must be the solver's default case.
 """
 import dataclasses
@@ -91,7 +91,7 @@ def _flatten(d, prefix=()):
             yield prefix + (k,), v
 
 
-@pytest.mark.parametrize("name", ["config.yaml", "stability.yaml", "settled.yaml"])
+@pytest.mark.parametrize("name", ["config.yaml", "stability.yaml"])
 def test_campaign_configs_set_only_what_differs_from_a_default(name):
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     restated = [".".join(p) for p, v in _flatten(cfg.get("case", {}))
