@@ -9,13 +9,8 @@
   from above the fluid in steps of dp/2 and interpolating linearly. For a uniform half
   space C = 1/2 exactly on its boundary, so the level sits on the continuum surface
   (dp/2 above the top particle row); over a dry bed it gives the bed.
-- line profiles: Shepard interpolation of the velocity, u(r) = sum u_j V_j W / sum V_j W over
-  fluid and wall particles, where C >= 0.5 (inside the fluid); NaN above the surface. The
-  wall particles carry the boundary condition's velocity (mDBC: the no-slip value
-  2 v_wall - v_ghost, the fluid's velocity field continued through the wall), which
-  completes the stencil near a wall: with fluid particles alone the sample within 2h of
-  the wall is one-sided and reads the fluid about 0.4 h further out (u* = 0.1 instead of 0
-  at the belt of the paper case at dp = 1 mm).
+- line profiles: Shepard interpolation of fluid velocity, u(r) = sum u_j V_j W / sum V_j W
+  (fluid only), where C >= 0.5 (inside the fluid); NaN above the surface.
 - number density: sum_j W(r - r_j) dp^2 over fluid particles (1.005 on the square lattice
   at Ch = 1.5, 1.002 at Ch = 1.8): falls when particles spread apart.
 """
@@ -34,8 +29,7 @@ C_SURFACE = 0.5
 
 @nb.njit(inline="always", cache=True)
 def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
-    """(C all, C fluid, sum u V W, sum w V W, sum W fluid) at point (px, pz); C and the
-    velocity sums over fluid and wall particles."""
+    """(C all, C fluid, sum u V W, sum w V W, sum W fluid) at point (px, pz)."""
     c_all = c_f = su = sw = nw = 0.0
     if cl.periodic:
         px = cl.x0 + (px - cl.x0) % cl.period
@@ -55,10 +49,10 @@ def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
                 W = w_value(math.sqrt(r2) / h, alpha)
                 VW = mass[j] / rho[j] * W
                 c_all += VW
-                su += u[j] * VW
-                sw += w[j] * VW
                 if kind[j] == 0:
                     c_f += VW
+                    su += u[j] * VW
+                    sw += w[j] * VW
                     nw += W
     return c_all, c_f, su, sw, nw
 
@@ -66,15 +60,14 @@ def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
 @nb.njit(parallel=True, cache=True)
 def sample_points(px, pz, x, z, u, w, rho, mass, kind, cl, h, out):
     """out[:, k] = (C all, C fluid, Shepard u, Shepard w, sum W fluid) at point k
-    (``cells.CellList`` cl); the Shepard velocity over fluid and wall particles, NaN where
-    no fluid is in reach."""
+    (``cells.CellList`` cl)."""
     alpha = alpha_2d(h)
     for k in nb.prange(px.size):
         c_all, c_f, su, sw, nw = _sums(px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h, alpha)
         out[0, k] = c_all
         out[1, k] = c_f
-        out[2, k] = su / c_all if c_f > 0 else np.nan
-        out[3, k] = sw / c_all if c_f > 0 else np.nan
+        out[2, k] = su / c_f if c_f > 0 else np.nan
+        out[3, k] = sw / c_f if c_f > 0 else np.nan
         out[4, k] = nw
 
 
