@@ -30,7 +30,6 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from savings import METRICS, metrics_of, run_case  # noqa: E402
 
 
-
 def example_overrides(name: str) -> list[str]:
     """--set overrides that turn examples/conveyor.yaml into examples/NAME.yaml (its top-level
     settings; name, shifting and the steady block are the run's own)."""
@@ -50,8 +49,7 @@ VARIANTS = {
     "average_1s": ["steady.average=1.0"],
     "cfl_0.3": ["cfl=0.3"],
     "cfl_0.3_average_1s": ["cfl=0.3", "steady.average=1.0"],
-    # examples/conveyor_fast.yaml: the consistent laminar term, the film profile as initial
-    # velocity, C 0.4 on the acoustic limit and 0.2 on the viscous one
+    # examples/conveyor_fast.yaml's settings (the file lists them and why)
     "fast": example_overrides("conveyor_fast"),
 }
 
