@@ -15,7 +15,7 @@ import numpy as np
 
 def fit_film_profile(z_star, u_star, depth_star, margin_star: float):
     """(nu_eff / nu, slip s) from the profile points with margin <= z* <= depth - margin
-    (away from the bed and the surface, where Shepard interpolation is truncated).
+    (away from the bed and the surface, where the interpolation stencil is one-sided).
     NaN where fewer than 5 finite points remain or the profile is not concave."""
     z = np.asarray(z_star, dtype=float)
     u = np.asarray(u_star, dtype=float)

@@ -9,8 +9,12 @@
   from above the fluid in steps of dp/2 and interpolating linearly. For a uniform half
   space C = 1/2 exactly on its boundary, so the level sits on the continuum surface
   (dp/2 above the top particle row); over a dry bed it gives the bed.
-- line profiles: Shepard interpolation of fluid velocity, u(r) = sum u_j V_j W / sum V_j W
-  (fluid only), where C >= 0.5 (inside the fluid); NaN above the surface.
+- line profiles: fluid velocity where C >= 0.5 (inside the fluid; NaN above the surface),
+  by the linear moving-least-squares fit over fluid particles, u(r) = a with
+  (a, b) = argmin sum_j V_j W_j (u_j - a - b.(r_j - r))^2. It is exact for a linear field
+  even where the stencil is one-sided (at the bed and the surface), where the Shepard mean
+  sum u_j V_j W / sum V_j W is biased by about h |grad u|; the Shepard mean is used where
+  the fit is singular (a single row of particles).
 - number density: sum_j W(r - r_j) dp^2 over fluid particles (1.005 on the square lattice
   at Ch = 1.5, 1.002 at Ch = 1.8): falls when particles spread apart.
 """
@@ -25,6 +29,7 @@ from .cells import cell_of, neighbour_cell
 from .kernel import alpha_2d, grad_coefficient, w_value
 
 C_SURFACE = 0.5
+MLS_MIN_DET = 1.0e-3  # det(M) / M_00^3 below which the linear fit falls back to Shepard
 
 
 @nb.njit(inline="always", cache=True)
@@ -57,18 +62,75 @@ def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
     return c_all, c_f, su, sw, nw
 
 
+@nb.njit(inline="always", cache=True)
+def _linear_velocity(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha, u_shepard, w_shepard):
+    """(u, w) at (px, pz) from the first-order (linear) moving-least-squares fit over fluid
+    particles: minimise sum_j V_j W_j (u_j - a - b (x_j - px) - c (z_j - pz))^2 and return a.
+    Exact for a linear field however one-sided the stencil; the Shepard values are returned
+    where the normalised moment matrix is near-singular (det < MLS_MIN_DET: a line of
+    particles, a lone tip)."""
+    if cl.periodic:
+        px = cl.x0 + (px - cl.x0) % cl.period
+    ix, iz = cell_of(cl, px, pz)
+    four_h2 = 4.0 * h * h
+    m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+    bu0 = bu1 = bu2 = bw0 = bw1 = bw2 = 0.0
+    for ddx in range(-1, 2):
+        for ddz in range(-1, 2):
+            c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
+            if c < 0:
+                continue
+            for j in range(cl.start[c], cl.start[c + 1]):
+                if kind[j] != 0:
+                    continue
+                dx = (x[j] + shift) - px
+                dz = z[j] - pz
+                r2 = dx * dx + dz * dz
+                if r2 >= four_h2:
+                    continue
+                VW = mass[j] / rho[j] * w_value(math.sqrt(r2) / h, alpha)
+                ex = dx / h
+                ez = dz / h
+                m00 += VW
+                m01 += VW * ex
+                m02 += VW * ez
+                m11 += VW * ex * ex
+                m12 += VW * ex * ez
+                m22 += VW * ez * ez
+                bu0 += VW * u[j]
+                bu1 += VW * u[j] * ex
+                bu2 += VW * u[j] * ez
+                bw0 += VW * w[j]
+                bw1 += VW * w[j] * ex
+                bw2 += VW * w[j] * ez
+    if m00 <= 0.0:
+        return u_shepard, w_shepard
+    # Cramer's rule for the first unknown of the symmetric 3x3 system M a = b
+    c11 = m11 * m22 - m12 * m12
+    c12 = m02 * m12 - m01 * m22
+    c13 = m01 * m12 - m02 * m11
+    det = m00 * c11 + m01 * c12 + m02 * c13
+    if det < MLS_MIN_DET * m00 * m00 * m00:
+        return u_shepard, w_shepard
+    return (bu0 * c11 + bu1 * c12 + bu2 * c13) / det, (bw0 * c11 + bw1 * c12 + bw2 * c13) / det
+
+
 @nb.njit(parallel=True, cache=True)
 def sample_points(px, pz, x, z, u, w, rho, mass, kind, cl, h, out):
-    """out[:, k] = (C all, C fluid, Shepard u, Shepard w, sum W fluid) at point k
-    (``cells.CellList`` cl)."""
+    """out[:, k] = (C all, C fluid, u, w, sum W fluid) at point k (``cells.CellList`` cl);
+    u and w by the linear fit of ``_linear_velocity`` (Shepard where it is singular)."""
     alpha = alpha_2d(h)
     for k in nb.prange(px.size):
         c_all, c_f, su, sw, nw = _sums(px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h, alpha)
         out[0, k] = c_all
         out[1, k] = c_f
-        out[2, k] = su / c_f if c_f > 0 else np.nan
-        out[3, k] = sw / c_f if c_f > 0 else np.nan
         out[4, k] = nw
+        if c_f > 0:
+            out[2, k], out[3, k] = _linear_velocity(px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h,
+                                                    alpha, su / c_f, sw / c_f)
+        else:
+            out[2, k] = np.nan
+            out[3, k] = np.nan
 
 
 @nb.njit(parallel=True, cache=True)

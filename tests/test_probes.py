@@ -57,14 +57,26 @@ def test_velocity_line_profile(profile):
     assert inside[:-1].all()  # every point below the surface counts as fluid
     u = out[2][inside]
     err = np.abs(u - f(z[inside]))
-    # interior: Shepard interpolation of a linear field is exact on a symmetric stencil
-    # (second-order error for the parabola); within 2h of the bed or the surface the
-    # one-sided stencil biases it by about the velocity change over h
+    # the linear moving-least-squares fit reproduces a linear field exactly, one-sided stencil
+    # at the bed and the surface included; for the parabola (curvature 2U/H^2) its error is the
+    # second-moment term, below U (h/H)^2 everywhere (measured: 0.15 of that, at the bed)
     h = sim.h
-    interior = (z[inside] > 2 * h) & (z[inside] < H - 2 * h)
-    tol_int = 1e-9 * U if profile == "linear" else 0.01 * U
-    assert err[interior].max() <= tol_int
-    assert err.max() <= U * h / H  # dp-level near the edges
+    tol = 1e-9 * U if profile == "linear" else U * (h / H) ** 2
+    assert err.max() <= tol
+
+
+def test_velocity_falls_back_to_shepard_on_a_single_row():
+    """A line of particles cannot fix a linear fit across it: the probe then returns the
+    Shepard mean, which for a uniform row is the row's velocity."""
+    scene = scene_from_dict({
+        "dp": DP, "ch": 1.8,
+        "fluid": {"density": 1000.0, "viscosity": 1.0, "blocks": [{"x": [0.0, 0.05], "z": [0.0, DP]}]},
+        "walls": [{"name": "bed", "x": [-0.005, 0.07], "z": [-0.004, 0.0]}],
+        "sound": {"c0": 5.0}, "time": {"end": 1.0, "output_interval": 1.0}})
+    parts = build_particles(scene)
+    parts.u[parts.kind == 0] = 0.3
+    out = FieldSampler(Simulation(scene, parts)).points(np.full(3, 0.025), np.array([0.0, 0.5 * DP, DP]))
+    np.testing.assert_allclose(out[2], 0.3, rtol=1e-12)
 
 
 def test_toe_of_a_block_and_stray_particle():
