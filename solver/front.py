@@ -22,9 +22,11 @@ from .run import Runner
 from .simulation import Simulation
 from .sources import source_hash
 
-SERIES = ("toe", "front_position", "uniform_depth", "enclosed_area", "mass_area", "number_density")
+SERIES = ("toe", "front_position", "front_equivalent", "uniform_depth", "enclosed_area", "mass_area",
+          "number_density")
 ZONES = ("wall", "body", "front", "in_walls")
 WALL_ZONE = 2.0  # h_n: the upstream wall region (the belt taper and the corner flow)
+FRONT_ANCHOR = 4.0  # h_n upstream of the first toe: the lab-fixed x0 of the equivalent front
 
 
 def zone_budget(x, z, volume, xs, zs, toe, h_n, front_length):
@@ -53,6 +55,31 @@ def zone_budget(x, z, volume, xs, zs, toe, h_n, front_length):
     return enclosed, mass
 
 
+def equivalent_front(x, volume, x0, h_n, h):
+    """x0 + (fluid area downstream of x0) / h_n: where a layer of depth h_n holding the
+    fluid downstream of the lab-fixed x0 would end. A front that advances by d at constant
+    shape moves it by d; it sums every particle downstream of x0 (each weighted by a linear
+    ramp over x0 +- h), so it does not jump as particles join or leave the tip or the
+    surface as the toe and the h_n / 2 crossing do."""
+    weight = np.clip((x - x0) / (2.0 * h) + 0.5, 0.0, 1.0)
+    return float(x0 + np.dot(weight, volume) / h_n)
+
+
+def strip_mean_velocity(x, z, u, volume, x_station, h):
+    """Volume-weighted mean horizontal velocity of the fluid in a vertical strip at each
+    x_station: sum_j V_j u_j w_j / sum_j V_j w_j, w_j = (1 - (dx / 2h)^2)^2 for |dx| < 2h
+    (fluid above the bed). It is the depth-mean velocity q / h of the strip, from the
+    particles themselves: no surface level, no interpolation; in the belt frame it is
+    1 + (lab-frame flux) / (u_b h), so 1 at any station of a steady front."""
+    out = np.full(len(x_station), math.nan)
+    for k, xs in enumerate(x_station):
+        m = (np.abs(x - xs) < 2.0 * h) & (z >= 0.0)
+        if m.any():
+            w = volume[m] * (1.0 - ((x[m] - xs) / (2.0 * h)) ** 2) ** 2
+            out[k] = float(np.dot(w, u[m]) / w.sum())
+    return out
+
+
 class FrontMonitor:
     """Samples the probes every ``case.probes.interval``; detects steady state, then ends
     the run after the averaging window. Fires the area-drift guard."""
@@ -73,6 +100,8 @@ class FrontMonitor:
         self.disorder: list[np.ndarray] = []  # (M_xx, M_zz, h |sum V gradW|) in the uniform zone
         self.surface: list[np.ndarray] = []  # z_max over x_star
         self.velocity: list[np.ndarray] = []  # u* over (station, z_star)
+        self.station_u: list[np.ndarray] = []  # depth-mean u* of each station
+        self.x_anchor = math.nan  # x0 of the equivalent front, set at the first sample
 
     @property
     def t_steady(self) -> float:
@@ -108,12 +137,17 @@ class FrontMonitor:
         lo, hi = c.probes.uniform_zone
         zone = (self.x_star >= lo) & (self.x_star <= hi)
         depth = float(np.nanmean(surface[zone])) if np.isfinite(surface[zone]).any() else math.nan
+        if math.isnan(self.x_anchor):
+            self.x_anchor = toe - FRONT_ANCHOR * hn
+        front_eq = equivalent_front(xf, vol, self.x_anchor, hn, sim.h)
         # velocity lines at the stations
-        px = np.repeat(toe - self.stations * hn, self.z_star.size)
+        x_station = toe - self.stations * hn
+        px = np.repeat(x_station, self.z_star.size)
         pz = np.tile(self.z_star * hn, self.stations.size)
         out = fs.points(px, pz)
         inside = out[0] >= C_SURFACE
         u_star = np.where(inside, (out[2] + ub) / ub, np.nan).reshape(self.stations.size, -1)
+        station_u = (strip_mean_velocity(xf, sim.z[:n][fl], sim.u[:n][fl], vol, x_station, sim.h) + ub) / ub
         # interior number density in the uniform zone: mid-depth points
         zx = toe - np.linspace(lo, hi, 7) * hn
         nd = fs.points(np.repeat(zx, 3), np.tile(np.array([0.3, 0.45, 0.6]) * depth, zx.size))
@@ -126,7 +160,8 @@ class FrontMonitor:
                                   & (za >= 2.0 * sim.h) & (za <= depth - 2.0 * sim.h))
             if core.size:
                 disorder = fs.disorder(core).mean(axis=1)
-        return {"toe": toe, "front_position": front, "uniform_depth": depth, "enclosed_area": enclosed,
+        return {"toe": toe, "front_position": front, "front_equivalent": front_eq, "uniform_depth": depth,
+                "enclosed_area": enclosed, "station_u": station_u,
                 "mass_area": mass_area, "number_density": number_density,
                 "zone_enclosed": zone_enclosed, "zone_mass": zone_mass, "disorder": disorder,
                 "surface": surface, "velocity": u_star}
@@ -144,7 +179,7 @@ class FrontMonitor:
             span = k * crit.window
             if k > 1 and t[-1] - span < max(crit.min_time, t[0]) - 1e-9:
                 break
-            r = steady.assess(t, self.series["front_position"], self.series["uniform_depth"],
+            r = steady.assess(t, self.series["front_equivalent"], self.series["uniform_depth"],
                               self.station_means(), crit, self.case.belt.speed, self.case.h_n,
                               t_start=t[-1] - span)["ratio"]
             worst = max((v if np.isfinite(v) else math.inf) for v in r.values())
@@ -166,10 +201,8 @@ class FrontMonitor:
         return text
 
     def station_means(self) -> np.ndarray:
-        """Depth-mean u* of each station over time, (time, station)."""
-        v = np.asarray(self.velocity)
-        with np.errstate(all="ignore"):
-            return np.nanmean(v, axis=2)
+        """Depth-mean u* of each station over time, (time, station) (``strip_mean_velocity``)."""
+        return np.asarray(self.station_u, dtype=float).reshape(len(self.t), self.stations.size)
 
     # ---- monitor protocol ------------------------------------------------------------
     def __call__(self, sim: Simulation):
@@ -182,12 +215,13 @@ class FrontMonitor:
         self.disorder.append(s["disorder"])
         self.surface.append(s["surface"])
         self.velocity.append(s["velocity"])
+        self.station_u.append(s["station_u"])
         drift = s["enclosed_area"] / s["mass_area"] - 1.0
         if abs(drift) > self.case.max_area_drift:
             return ("diverged", f"t = {sim.t:.6g} s: enclosed area differs from the mass-implied "
                     f"area by {100 * drift:+.1f} % (max_area_drift = {self.case.max_area_drift:g})")
         if self.state != "steady":
-            self.state = self.tracker.update(self.t, self.series["front_position"],
+            self.state = self.tracker.update(self.t, self.series["front_equivalent"],
                                              self.series["uniform_depth"], self.station_means())
             if self.state == "steady" and self.case.steady.stop:
                 return ("completed", "")
@@ -204,6 +238,14 @@ class FrontMonitor:
             "front_position": (("time",), np.asarray(self.series["front_position"]),
                                {"units": "m",
                                 "long_name": "most downstream x where the free surface is at h_n / 2, lab frame"}),
+            "front_equivalent": (("time",), np.asarray(self.series["front_equivalent"]),
+                                 {"units": "m", "long_name": "x0 + fluid area downstream of x0 / h_n, lab frame "
+                                  f"(x0 = {self.x_anchor:.6g} m, {FRONT_ANCHOR:g} h_n upstream of the first toe); "
+                                  "the steady detection's front signal"}),
+            "station_mean_velocity": (("time", "station"), self.station_means(),
+                                      {"units": "1", "long_name": "depth-mean u* at the station: volume-weighted mean "
+                                       "of the fluid particles in a strip +- 2h wide; the steady detection's "
+                                       "velocity signal"}),
             "uniform_depth": (("time",), np.asarray(self.series["uniform_depth"]),
                               {"units": "m", "long_name": "mean free-surface elevation over the uniform zone"}),
             "enclosed_area": (("time",), np.asarray(self.series["enclosed_area"]),
@@ -224,7 +266,7 @@ class FrontMonitor:
                                   {"units": "m", "long_name": "free surface z_max (C = 0.5 level)"}),
             "velocity_star": (("time", "station", "z_star"),
                               np.asarray(self.velocity).reshape(t.size, self.stations.size, -1),
-                              {"units": "1", "long_name": "(u + u_b) / u_b, belt frame, Shepard interpolated"}),
+                              {"units": "1", "long_name": "(u + u_b) / u_b, belt frame, linear MLS interpolated"}),
         }
         ds = xr.Dataset(data, coords={
             "time": ("time", t, {"units": "s", "long_name": "probe time"}),
@@ -266,7 +308,7 @@ class FrontMonitor:
         else:
             start = final
             steady_found = bool(np.isfinite(self.t_steady) and self.t_steady <= final + 1e-9
-                                and self.tracker.verify(t, self.series["front_position"],
+                                and self.tracker.verify(t, self.series["front_equivalent"],
                                                         self.series["uniform_depth"],
                                                         self.station_means(), final))
         ds.attrs["steady_state_time_s"] = float(self.t_steady) if steady_found else math.nan

@@ -1,5 +1,6 @@
 """Steady-state detection on synthetic signals."""
 import numpy as np
+import pytest
 
 from solver.steady import SteadyCriteria, SteadyTracker, assess, drifts, is_steady, trend, trend_bound
 
@@ -87,10 +88,12 @@ def test_fixed_end_time_averages_the_final_window():
         tt = np.asarray(m.t)
         depth = np.where(tt < 1.5, 0.010, 0.018) - thinning * tt  # a step the window must see or not
         n = len(m.t)
-        m.series = {"toe": [0.4] * n, "front_position": [0.38] * n, "uniform_depth": list(depth),
+        m.series = {"toe": [0.4] * n, "front_position": [0.38] * n, "front_equivalent": [0.39] * n,
+                    "uniform_depth": list(depth),
                     "enclosed_area": [1.0] * n, "mass_area": [1.0] * n, "number_density": [1.0] * n}
         m.surface = [np.zeros(m.x_star.size)] * n
         m.velocity = [np.ones((m.stations.size, m.z_star.size))] * n
+        m.station_u = [np.ones(m.stations.size)] * n
         m.zone_enclosed = m.zone_mass = [np.ones(4)] * n
         m.disorder = [np.ones(3)] * n
         m.tracker.t_steady, m.tracker.t_end = t_steady, t_steady + 2.0
@@ -276,10 +279,47 @@ def test_reason_names_the_failing_signal_over_the_span_closest_to_passing():
     t, toe, depth, su = noisy_signals(10.0, 2e-3, toe_drift=0.03 * m.case.belt.speed, noise_dp=0.1,
                                       seed=2, red=0.5)
     m.t = list(t)
-    m.series = {"front_position": list(toe), "uniform_depth": list(depth)}
-    m.velocity = [np.full((m.stations.size, m.z_star.size), v) for v in su[:, 0]]
+    m.series = {"front_equivalent": list(toe), "uniform_depth": list(depth)}
+    m.station_u = [np.full(m.stations.size, v) for v in su[:, 0]]
     reason = m.why_not_steady()
     assert "front position" in reason and "uniform depth" not in reason and "velocity" not in reason
     assert "over the final 8 s" in reason
     ratio = float(re.search(r"front position ([0-9.]+)x", reason).group(1))
     assert 2.7 <= ratio <= 3.6, reason  # the drift 3x, plus 2 se
+
+
+def test_equivalent_front_moves_with_a_block_and_ignores_a_tip_particle():
+    """x0 + area downstream / h_n of a lattice block of depth h_n ending at L is L (to 0.01 dp:
+    the ramp over x0 +- h summed on the lattice); it moves by d when the block moves by d, and
+    one particle joining the tip moves it by dp^2 / h_n."""
+    from solver.front import equivalent_front
+    dp, hn, h = 1e-3, 0.02, 1.8 * np.sqrt(2) * 1e-3
+    xc, zc = np.meshgrid((np.arange(300) + 0.5) * dp, (np.arange(20) + 0.5) * dp)
+    x, vol = xc.ravel(), np.full(xc.size, dp * dp)
+    x0 = 0.2137
+    base = equivalent_front(x, vol, x0, hn, h)
+    assert base == pytest.approx(0.3, abs=0.01 * dp)
+    for d in (0.37 * dp, 2.5 * dp):
+        assert equivalent_front(x + d, vol, x0, hn, h) == pytest.approx(0.3 + d, abs=0.01 * dp)
+    tip = equivalent_front(np.append(x, 0.3 + 0.5 * dp), np.append(vol, dp * dp), x0, hn, h)
+    assert tip - base == pytest.approx(dp * dp / hn, rel=1e-9)
+
+
+def test_strip_mean_velocity_of_the_film_is_the_depth_mean():
+    """On a lattice layer of depth H carrying the belt-frame film profile
+    u* = 3 (z/H - z^2 / 2H^2), the strip mean is its depth mean 1 (midpoint rule over the
+    rows: error dp^2 |u''| / 24 = 0.0003 here); particles below the bed do not count."""
+    from solver.front import strip_mean_velocity
+    dp, H, h = 1e-3, 0.0186, 1.8 * np.sqrt(2) * 1e-3
+    xc, zc = np.meshgrid((np.arange(100) + 0.5) * dp, (np.arange(round(H / dp)) + 0.5) * dp)
+    x, z = xc.ravel(), zc.ravel()
+    Hd = round(H / dp) * dp
+    u_star = 3.0 * (z / Hd - z * z / (2 * Hd * Hd))
+    vol = np.full(x.size, dp * dp)
+    got = strip_mean_velocity(x, z, u_star, vol, np.array([0.0317, 0.05, 0.0712]), h)
+    np.testing.assert_allclose(got, 1.0, atol=dp ** 2 * 3 / Hd ** 2 / 24 * 1.01)
+    # a stray particle under the bed with a wild velocity is ignored
+    got2 = strip_mean_velocity(np.append(x, 0.05), np.append(z, -0.5 * dp), np.append(u_star, 50.0),
+                               np.append(vol, dp * dp), np.array([0.05]), h)
+    assert got2[0] == pytest.approx(got[1], rel=1e-12)
+    assert np.isnan(strip_mean_velocity(x, z, u_star, vol, np.array([1.0]), h)[0])
