@@ -177,9 +177,6 @@ def validate_case(c: ConveyorCase) -> None:
     if c.start == "warm" and c.start_velocity != "rest":
         raise SceneError("case.start_velocity: a warm start takes its velocities from warm_from; "
                          "leave start_velocity at rest")
-    if not c.newtonian and c.start_velocity != "rest":
-        raise SceneError("case.start_velocity: the lubrication start velocity is for newtonian "
-                         "fluids; a herschel_bulkley case starts at rest")
     if c.start == "warm" and not c.warm_from:
         raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")
@@ -326,10 +323,12 @@ def build_scene(c: ConveyorCase, warm=None) -> Scene:
 
 
 def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.ndarray):
-    """Lab-frame (u, w) of the steady film at fluid points: u = U (u*(z/h) - 1), w = 0, with
-    u* = 3 (s - s^2/2) of SPEC section 5 at the local depth h of the initial surface and U
-    the speed of the bed wall under the point (the belt, or its taper near the upstream
-    wall). The depth-mean lab velocity is then zero: no net flux."""
+    """Lab-frame (u, w) of the steady film at fluid points, w = 0: at the local depth h of
+    the initial surface and under a bed moving upslope at U (the belt, or its taper near the
+    upstream wall), u = u_rel(z) - U with u_rel the film relative to the bed whose flux is
+    U h. Newtonian: u_rel = U 3 (s - s^2/2), s = z / h (SPEC section 5). Herschel-Bulkley:
+    u_rel = ``HBFluid.film`` at the driving slope S(h) of q(h, S) = U h. The depth-mean lab
+    velocity is then zero: no net flux."""
     if scene.fluid.profiles:
         prof = scene.fluid.profiles[0]
         depth = prof.top(x) - prof.base
@@ -339,6 +338,22 @@ def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.nda
     for w in scene.walls:
         if w.z[1] <= 0.0:  # bed walls: the belt and its taper segments
             speed[(x >= w.x[0]) & (x < w.x[1])] = -w.velocity[0]
-    s = np.clip(z / np.maximum(depth, 1e-12), 0.0, 1.0)
-    u = speed * (lubrication.belt_velocity(s) - 1.0)
+    depth = np.maximum(depth, 1e-12)
+    if c.newtonian:
+        s = np.clip(z / depth, 0.0, 1.0)
+        u = speed * (lubrication.belt_velocity(s) - 1.0)
+        return u, np.zeros_like(u)
+    u = -speed.copy()
+    fluid = c.hb_fluid
+    # one driving slope per (depth, bed speed): the particles of a lattice column share both
+    keys = np.stack([np.round(depth / c.dp, 6), speed], axis=1)
+    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+    order = np.argsort(inverse.ravel(), kind="stable")
+    groups = np.split(order, np.cumsum(np.bincount(inverse.ravel(), minlength=len(uniq)))[:-1])
+    for (_, U), sel in zip(uniq, groups):
+        if U <= 0.0 or sel.size == 0:
+            continue
+        h = float(depth[sel[0]])
+        S = viscoplastic.driving_slope(fluid, h, U, c.gravity)
+        u[sel] = fluid.film(np.clip(z[sel], 0.0, h), h, S, c.gravity) - U
     return u, np.zeros_like(u)

@@ -59,7 +59,29 @@ def test_conveyor_case_for_a_yield_stress_fluid():
     assert area == pytest.approx(c.fluid_length * c.h_n ** 2, rel=2e-3)
     assert initial_toe(c) > c.fluid_length * c.h_n
     with pytest.raises(SceneError, match="start_velocity"):
-        case_from_dict({**HB_CASE, "start_velocity": "lubrication"})
+        case_from_dict({**HB_CASE, "start_velocity": "moving"})
+
+
+def test_lubrication_start_velocity_of_a_yield_stress_fluid():
+    """The Herschel-Bulkley film at the local depth: u = -U on the belt (no slip), a plug of
+    uniform velocity above h0 = h - tau_y / (rho g S), and zero lab-frame flux in every column
+    (the film's flux relative to the belt is U h)."""
+    from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
+    c = case_from_dict({**HB_CASE, "start_velocity": "lubrication", "dp": 1.0e-3})
+    scene = build_scene(c)
+    assert c.running_start
+    fluid = HBFluid(rho=1000.0, tau_y=20.0, K=10.0, n=0.4)
+    s = np.linspace(0.0, 1.0, 4001)
+    for x in (0.5 * c.h_n, 5 * c.h_n, 15 * c.h_n, 20.5 * c.h_n):  # taper, body, near the toe
+        top = scene.fluid.profiles[0].top(x)
+        u, w = lubrication_velocity(c, scene, np.full(s.size, x), s * top)
+        U = -u[0]
+        assert U > 0 and not w.any()
+        assert abs(np.trapezoid(u, s)) < 1e-4 * U  # trapezoid error at the yield surface's kink
+        S = driving_slope(fluid, top, U, G)
+        h0 = top - 20.0 / (1000.0 * G * S)
+        plug = s * top >= h0
+        assert plug.any() and np.ptp(u[plug]) < 1e-12 * U
 
 
 def test_reference_for_a_yield_stress_fluid():
