@@ -26,7 +26,7 @@ SERIES = ("toe", "front_position", "front_equivalent", "uniform_depth", "enclose
           "number_density")
 ZONES = ("wall", "body", "front", "in_walls")
 WALL_ZONE = 2.0  # h_n: the upstream wall region (the belt taper and the corner flow)
-FRONT_ANCHOR = 4.0  # h_n upstream of the first toe: the lab-fixed x0 of the equivalent front
+FRONT_ANCHOR = 4.0  # h_n upstream of the first toe (at most half-way to the wall): x0 of the equivalent front
 
 
 def zone_budget(x, z, volume, xs, zs, toe, h_n, front_length):
@@ -140,7 +140,7 @@ class FrontMonitor:
         zone = (self.x_star >= lo) & (self.x_star <= hi)
         depth = float(np.nanmean(surface[zone])) if np.isfinite(surface[zone]).any() else math.nan
         if math.isnan(self.x_anchor):
-            self.x_anchor = toe - FRONT_ANCHOR * hn
+            self.x_anchor = max(toe - FRONT_ANCHOR * hn, 0.5 * toe)  # inside the fluid
         front_eq = equivalent_front(xf, vol, self.x_anchor, hn, sim.h)
         # velocity lines at the stations
         x_station = toe - self.stations * hn
@@ -242,7 +242,8 @@ class FrontMonitor:
                                 "long_name": "most downstream x where the free surface is at h_n / 2, lab frame"}),
             "front_equivalent": (("time",), np.asarray(self.series["front_equivalent"]),
                                  {"units": "m", "long_name": "x0 + fluid area downstream of x0 / h_n, lab frame "
-                                  f"(x0 = {self.x_anchor:.6g} m, {FRONT_ANCHOR:g} h_n upstream of the first toe); "
+                                  f"(x0 = {self.x_anchor:.6g} m, {FRONT_ANCHOR:g} h_n upstream of the first toe or "
+                                  "half-way to the wall if nearer); "
                                   "the steady detection's front signal"}),
             "station_mean_velocity": (("time", "station"), self.station_means(),
                                       {"units": "1", "long_name": "depth-mean u* at the station: volume-weighted mean "
