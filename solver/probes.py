@@ -33,9 +33,9 @@ MLS_MIN_DET = 1.0e-3  # det(M) / M_00^3 below which the linear fit falls back to
 
 
 @nb.njit(inline="always", cache=True)
-def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
-    """(C all, C fluid, sum u V W, sum w V W, sum W fluid) at point (px, pz)."""
-    c_all = c_f = su = sw = nw = 0.0
+def _concentration(px, pz, x, z, rho, mass, cl, h, alpha):
+    """C = sum_j V_j W(r - r_j) over fluid and wall particles at point (px, pz)."""
+    c_all = 0.0
     if cl.periodic:
         px = cl.x0 + (px - cl.x0) % cl.period
     ix, iz = cell_of(cl, px, pz)
@@ -49,30 +49,24 @@ def _sums(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
                 dx = px - (x[j] + shift)
                 dz = pz - z[j]
                 r2 = dx * dx + dz * dz
-                if r2 >= four_h2:
-                    continue
-                W = w_value(math.sqrt(r2) / h, alpha)
-                VW = mass[j] / rho[j] * W
-                c_all += VW
-                if kind[j] == 0:
-                    c_f += VW
-                    su += u[j] * VW
-                    sw += w[j] * VW
-                    nw += W
-    return c_all, c_f, su, sw, nw
+                if r2 < four_h2:
+                    c_all += mass[j] / rho[j] * w_value(math.sqrt(r2) / h, alpha)
+    return c_all
 
 
 @nb.njit(inline="always", cache=True)
-def _linear_velocity(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha, u_shepard, w_shepard):
-    """(u, w) at (px, pz) from the first-order (linear) moving-least-squares fit over fluid
-    particles: minimise sum_j V_j W_j (u_j - a - b (x_j - px) - c (z_j - pz))^2 and return a.
-    Exact for a linear field however one-sided the stencil; the Shepard values are returned
-    where the normalised moment matrix is near-singular (det < MLS_MIN_DET: a line of
-    particles, a lone tip)."""
+def _point_values(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha):
+    """(C all, C fluid, u, w, sum W fluid) at (px, pz), in one pass over the neighbours.
+    (u, w) is the first-order (linear) moving-least-squares fit over fluid particles:
+    minimise sum_j V_j W_j (u_j - a - b (x_j - px) - c (z_j - pz))^2 and return a. Exact for
+    a linear field however one-sided the stencil; the Shepard mean sum u V W / sum V W is
+    returned where the normalised moment matrix is near-singular (det < MLS_MIN_DET: a line
+    of particles, a lone tip); NaN without fluid."""
     if cl.periodic:
         px = cl.x0 + (px - cl.x0) % cl.period
     ix, iz = cell_of(cl, px, pz)
     four_h2 = 4.0 * h * h
+    c_all = nw = 0.0
     m00 = m01 = m02 = m11 = m12 = m22 = 0.0
     bu0 = bu1 = bu2 = bw0 = bw1 = bw2 = 0.0
     for ddx in range(-1, 2):
@@ -81,14 +75,17 @@ def _linear_velocity(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha, u_shepar
             if c < 0:
                 continue
             for j in range(cl.start[c], cl.start[c + 1]):
-                if kind[j] != 0:
-                    continue
                 dx = (x[j] + shift) - px
                 dz = z[j] - pz
                 r2 = dx * dx + dz * dz
                 if r2 >= four_h2:
                     continue
-                VW = mass[j] / rho[j] * w_value(math.sqrt(r2) / h, alpha)
+                W = w_value(math.sqrt(r2) / h, alpha)
+                VW = mass[j] / rho[j] * W
+                c_all += VW
+                if kind[j] != 0:
+                    continue
+                nw += W
                 ex = dx / h
                 ez = dz / h
                 m00 += VW
@@ -104,47 +101,39 @@ def _linear_velocity(px, pz, x, z, u, w, rho, mass, kind, cl, h, alpha, u_shepar
                 bw1 += VW * w[j] * ex
                 bw2 += VW * w[j] * ez
     if m00 <= 0.0:
-        return u_shepard, w_shepard
+        return c_all, 0.0, np.nan, np.nan, nw
     # Cramer's rule for the first unknown of the symmetric 3x3 system M a = b
     c11 = m11 * m22 - m12 * m12
     c12 = m02 * m12 - m01 * m22
     c13 = m01 * m12 - m02 * m11
     det = m00 * c11 + m01 * c12 + m02 * c13
     if det < MLS_MIN_DET * m00 * m00 * m00:
-        return u_shepard, w_shepard
-    return (bu0 * c11 + bu1 * c12 + bu2 * c13) / det, (bw0 * c11 + bw1 * c12 + bw2 * c13) / det
+        return c_all, m00, bu0 / m00, bw0 / m00, nw
+    return c_all, m00, (bu0 * c11 + bu1 * c12 + bu2 * c13) / det, (bw0 * c11 + bw1 * c12 + bw2 * c13) / det, nw
 
 
 @nb.njit(parallel=True, cache=True)
 def sample_points(px, pz, x, z, u, w, rho, mass, kind, cl, h, out):
     """out[:, k] = (C all, C fluid, u, w, sum W fluid) at point k (``cells.CellList`` cl);
-    u and w by the linear fit of ``_linear_velocity`` (Shepard where it is singular)."""
+    u and w by the linear fit of ``_point_values`` (Shepard where it is singular)."""
     alpha = alpha_2d(h)
     for k in nb.prange(px.size):
-        c_all, c_f, su, sw, nw = _sums(px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h, alpha)
-        out[0, k] = c_all
-        out[1, k] = c_f
-        out[4, k] = nw
-        if c_f > 0:
-            out[2, k], out[3, k] = _linear_velocity(px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h,
-                                                    alpha, su / c_f, sw / c_f)
-        else:
-            out[2, k] = np.nan
-            out[3, k] = np.nan
+        out[0, k], out[1, k], out[2, k], out[3, k], out[4, k] = _point_values(
+            px[k], pz[k], x, z, u, w, rho, mass, kind, cl, h, alpha)
 
 
 @nb.njit(parallel=True, cache=True)
-def surface_elevation(xs, ztop, zfloor, step, x, z, u, w, rho, mass, kind, cl, h, out):
+def surface_elevation(xs, ztop, zfloor, step, x, z, rho, mass, cl, h, out):
     """Highest z in [zfloor, ztop[k]] where C = 0.5 on the vertical line x = xs[k]
     (zfloor if C < 0.5 all the way down)."""
     alpha = alpha_2d(h)
     for k in nb.prange(xs.size):
         zc = ztop[k]
-        c_prev = _sums(xs[k], zc, x, z, u, w, rho, mass, kind, cl, h, alpha)[0]
+        c_prev = _concentration(xs[k], zc, x, z, rho, mass, cl, h, alpha)
         out[k] = zfloor
         while zc > zfloor:
             zn = max(zc - step, zfloor)
-            c = _sums(xs[k], zn, x, z, u, w, rho, mass, kind, cl, h, alpha)[0]
+            c = _concentration(xs[k], zn, x, z, rho, mass, cl, h, alpha)
             if c >= 0.5:
                 if c_prev < 0.5:
                     out[k] = zn + (c - 0.5) / (c - c_prev) * (zc - zn)
@@ -251,5 +240,5 @@ class FieldSampler:
             if hi[k] > lo[k]:
                 ztop[k] = zf[lo[k]:hi[k]].max() + reach
         out = np.empty(xs.size)
-        surface_elevation(xs, ztop, zfloor, 0.5 * s.scene.dp, *self._grid_args(), out)
+        surface_elevation(xs, ztop, zfloor, 0.5 * s.scene.dp, s.x, s.z, s.rho, s.mass, s.cells, s.h, out)
         return out
