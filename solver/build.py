@@ -19,7 +19,7 @@ class Particles:
     u: np.ndarray
     w: np.ndarray
     rho: np.ndarray
-    mass: np.ndarray  # rho(t=0) dp^2: particle volumes match the lattice
+    mass: np.ndarray  # rho(t=0) dp dz: particle volumes match the lattice cells
     kind: np.ndarray  # int8: 0 fluid, 1 boundary
     wall: np.ndarray  # int32: wall index, -1 for fluid
     gx: np.ndarray  # ghost node of a boundary particle
@@ -50,39 +50,44 @@ def hydrostatic_density(scene: Scene, z: np.ndarray, top) -> np.ndarray:
     return rho0 * (1.0 + 6.0 * (-scene.gravity[1]) * d / (c0 * c0)) ** (1.0 / 6.0)
 
 
-def profile_lattice(profile, dp: float) -> tuple[np.ndarray, np.ndarray]:
-    """Lattice points of a profile region: columns dp/2 inside [x0, x1], rows from base + dp/2
-    while below the surface."""
+def profile_lattice(profile, dp: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Lattice points of a profile region: columns dp/2 inside [x0, x1], rows dz apart from
+    base + dz/2 while below the surface (round((top - base) / dz) rows per column), and the
+    row spacing dz (``FluidProfile.row_spacing``)."""
+    dz = profile.row_spacing(dp)
     nx = int(round((profile.x[1] - profile.x[0]) / dp))
     xs = profile.x[0] + (np.arange(nx) + 0.5) * dp
     tops = profile.top(xs)
     X, Z = [], []
     for x, top in zip(xs, tops):
-        n = int(np.floor((top - profile.base) / dp + 0.5))
+        n = int(np.floor((top - profile.base) / dz + 0.5))
         if n > 0:
             X.append(np.full(n, x))
-            Z.append(profile.base + (np.arange(n) + 0.5) * dp)
+            Z.append(profile.base + (np.arange(n) + 0.5) * dz)
     if not X:
-        return np.zeros(0), np.zeros(0)
-    return np.concatenate(X), np.concatenate(Z)
+        return np.zeros(0), np.zeros(0), dz
+    return np.concatenate(X), np.concatenate(Z), dz
 
 
-def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None) -> np.ndarray:
-    """Free-surface height above each query point: the top (+ dp/2) of the contiguous run of
+def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None,
+                dz=None) -> np.ndarray:
+    """Free-surface height above each query point: the top (+ dz/2) of the contiguous run of
     fluid lattice points in its column that starts at or just above it.
 
-    Fluid points are (x, z); queries default to the fluid points themselves.
+    Fluid points are (x, z) with row spacings ``dz`` (default dp); queries default to the
+    fluid points themselves.
     """
     qx = x if qx is None else qx
     qz = z if qz is None else qz
+    dz = np.full(x.size, dp) if dz is None else np.asarray(dz, dtype=float)
     col = np.round(x / dp).astype(np.int64)
     order = np.lexsort((z, col))
     cs, zs = col[order], z[order]
-    # top of each contiguous run (same column, gaps of at most 1.5 dp)
+    # top of each contiguous run (same column, gaps of at most 1.5 rows)
     n = zs.size
-    run_top = zs.copy()
+    run_top = zs + 0.5 * dz[order]
     for i in range(n - 2, -1, -1):
-        if cs[i + 1] == cs[i] and zs[i + 1] - zs[i] < 1.5 * dp:
+        if cs[i + 1] == cs[i] and zs[i + 1] - zs[i] < 1.5 * dz[order][i]:
             run_top[i] = run_top[i + 1]
     out = np.full(qx.size, -np.inf)
     qcol = np.round(qx / dp).astype(np.int64)
@@ -93,7 +98,7 @@ def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None) -> np
             continue
         j = lo + np.searchsorted(zs[lo:hi], qz[k] - 0.5 * dp, side="left")
         if j < hi and zs[j] - qz[k] < 1.5 * dp:
-            out[k] = run_top[j] + 0.5 * dp
+            out[k] = run_top[j]
     return out
 
 
@@ -160,18 +165,19 @@ def build_particles(scene: Scene) -> Particles:
 
     Density starts hydrostatic (bed-normal gravity) below the local free surface of each
     column, for fluid and for the wall particles under it; each particle's mass is
-    rho dp^2 so that m/rho is the lattice cell volume.
+    rho dp dz so that m/rho is its lattice cell's volume (dz = dp but in a profile with
+    ``row_depth``).
     """
     dp = scene.dp
-    fx, fz, fu, fw = [], [], [], []
-    regions = [(b, lattice(b, dp)) for b in scene.fluid.blocks] + [
+    fx, fz, fu, fw, fdz = [], [], [], [], []
+    regions = [(b, (*lattice(b, dp), dp)) for b in scene.fluid.blocks] + [
         (p, profile_lattice(p, dp)) for p in scene.fluid.profiles]
-    for region, (x, z) in regions:
-        fx.append(x), fz.append(z)
+    for region, (x, z, dz) in regions:
+        fx.append(x), fz.append(z), fdz.append(np.full(x.size, dz))
         fu.append(np.full(x.size, region.velocity[0])), fw.append(np.full(x.size, region.velocity[1]))
-    fx, fz = np.concatenate(fx), np.concatenate(fz)
+    fx, fz, fdz = np.concatenate(fx), np.concatenate(fz), np.concatenate(fdz)
     fu, fw = np.concatenate(fu), np.concatenate(fw)
-    frho = hydrostatic_density(scene, fz, column_tops(fx, fz, dp))
+    frho = hydrostatic_density(scene, fz, column_tops(fx, fz, dp, dz=fdz))
 
     bx, bz, bwall = [], [], []
     for i, w in enumerate(scene.walls):
@@ -183,7 +189,7 @@ def build_particles(scene: Scene) -> Particles:
         bx, bz, bwall = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int32)
     # wall particles under fluid: continue the column above the wall top
     wall_top = np.array([scene.walls[i].z[1] for i in bwall]) if bx.size else np.zeros(0)
-    btop = column_tops(fx, fz, dp, bx, wall_top + 0.5 * dp)
+    btop = column_tops(fx, fz, dp, bx, wall_top + 0.5 * dp, dz=fdz)
     brho = hydrostatic_density(scene, bz, np.where(np.isfinite(btop), btop, -np.inf))
     gx = np.full(bx.size, np.nan)
     gz = np.full(bx.size, np.nan)
@@ -197,7 +203,7 @@ def build_particles(scene: Scene) -> Particles:
         x=np.concatenate([fx, bx]), z=np.concatenate([fz, bz]),
         u=np.concatenate([fu, np.zeros(nb)]), w=np.concatenate([fw, np.zeros(nb)]),
         rho=np.concatenate([frho, brho]),
-        mass=np.concatenate([frho, brho]) * dp * dp,
+        mass=np.concatenate([frho * fdz, brho * dp]) * dp,
         kind=np.concatenate([np.full(nf, FLUID, np.int8), np.full(nb, BOUNDARY, np.int8)]),
         wall=np.concatenate([np.full(nf, -1, np.int32), bwall]),
         gx=np.concatenate([np.full(nf, np.nan), gx]), gz=np.concatenate([np.full(nf, np.nan), gz]),

@@ -19,6 +19,7 @@ from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication", "warm")
 START_VELOCITIES = ("rest", "lubrication")
+START_DEPTHS = ("film", "theory")
 
 
 @dataclass
@@ -78,6 +79,7 @@ class ConveyorCase(YamlData):
     belt: Belt = field(default_factory=Belt)
     fluid_length: float = 20.0  # in h_n, of the initial block (the lubrication start keeps its area)
     start: str = "lubrication"
+    start_depth: str | None = None  # lubrication start's body: film or theory; null: film if newtonian
     start_velocity: str = "rest"  # or lubrication: the steady film profile, belt running from t = 0
     warm_from: str | None = None  # start: warm: a front run's NetCDF (another dp) to start from
     wall_height: float = 2.5  # upstream wall, in h_n
@@ -129,6 +131,14 @@ class ConveyorCase(YamlData):
                                           eta_max=1 - 1e-6)
 
     @property
+    def start_depth_rule(self) -> str:
+        """How the lubrication start's body depth is chosen: ``film``, the scheme's own
+        normal depth (``film_depth``, newtonian only), or ``theory``, h_n."""
+        if self.start_depth is not None:
+            return self.start_depth
+        return "film" if self.newtonian else "theory"
+
+    @property
     def running_start(self) -> bool:
         """The fluid starts moving (warm start, or the lubrication velocity profile) and the
         belt runs at full speed from t = 0, without rest or ramp."""
@@ -177,6 +187,12 @@ def validate_case(c: ConveyorCase) -> None:
     if c.start == "warm" and c.start_velocity != "rest":
         raise SceneError("case.start_velocity: a warm start takes its velocities from warm_from; "
                          "leave start_velocity at rest")
+    if c.start_depth is not None and c.start_depth not in START_DEPTHS:
+        raise SceneError(f"case.start_depth: {c.start_depth!r} is not one of "
+                         f"{', '.join(START_DEPTHS)} (or null: film for a newtonian fluid)")
+    if c.start_depth == "film" and not c.newtonian:
+        raise SceneError("case.start_depth: film measures the flux of a newtonian film; use "
+                         "theory (h_n) for rheology herschel_bulkley")
     if c.start == "warm" and not c.warm_from:
         raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")
@@ -217,24 +233,26 @@ def wall_thickness(c: ConveyorCase) -> float:
     return math.ceil(2.0 * c.ch - 1e-9) * c.dp
 
 
-def initial_toe(c: ConveyorCase, warm=None) -> float:
-    """x of the toe at t = 0."""
+def initial_toe(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> float:
+    """x of the toe at t = 0 (``body_depth``: the lubrication start's body depth in h_n)."""
     hn = c.h_n
     if warm is not None:
         return warm.toe
     if c.start == "block":
         return c.fluid_length * hn
+    hs = body_depth * hn
     if c.newtonian:
-        return (c.fluid_length + lubrication.front_area_deficit(c.theta)) * hn
+        return c.fluid_length * hn + lubrication.front_area_deficit(c.theta) * hs
     xs, eta = c.front_shape()
     deficit = float(np.sum(np.diff(xs) * (1 - 0.5 * (eta[1:] + eta[:-1]))))
-    return (c.fluid_length + deficit) * hn
+    return c.fluid_length * hn + deficit * hs
 
 
-def front_surface(c: ConveyorCase) -> list[list[float]]:
-    """Points of the lubrication front surface from the wall (x = 0) to the toe, with the
-    area of a block of length fluid_length h_n at depth h_n."""
-    hn, x_toe = c.h_n, initial_toe(c)
+def front_surface(c: ConveyorCase, body_depth: float = 1.0) -> list[list[float]]:
+    """Points of the lubrication front surface from the wall (x = 0) to the toe: the steady
+    front of normal depth h_s = body_depth h_n (lengths and depths scale with it), with the
+    area of a block of length fluid_length h_n at depth h_s."""
+    hn, x_toe = body_depth * c.h_n, initial_toe(c, body_depth=body_depth)
     xs, eta = c.front_shape()
     xi = xs * hn
     if c.newtonian:
@@ -251,13 +269,14 @@ def front_surface(c: ConveyorCase) -> list[list[float]]:
     return [[float(a), float(b)] for a, b in zip(x, z)]
 
 
-def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
+def build_scene_dict(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> dict:
     """The generic scene of SPEC section 2 as plain data. ``warm`` (a ``warm.WarmState``)
     gives the free surface of a warm start; without it a warm case is built with the
-    lubrication shape (for validation before the run it starts from exists)."""
+    lubrication shape (for validation before the run it starts from exists). The lubrication
+    start's body is ``body_depth`` h_n deep, its rows filling that depth exactly."""
     hn, th, g = c.h_n, c.theta, c.gravity
     T = wall_thickness(c)
-    x_toe = initial_toe(c, warm)
+    x_toe = initial_toe(c, warm, body_depth)
     rest, ramp = (0.0, 0.0) if c.running_start else (c.belt.rest, c.belt.ramp)
     belt_end = c.dp * math.ceil((x_toe + c.belt.margin * hn) / c.dp)
     wall_top = c.dp * math.ceil(c.wall_height * hn / c.dp)
@@ -274,9 +293,10 @@ def build_scene_dict(c: ConveyorCase, warm=None) -> dict:
     if c.start == "block":
         fluid = {"blocks": [{"x": [0.0, x_toe], "z": [0.0, hn]}]}
     else:
-        surface = warm.surface() if warm is not None else front_surface(c)
+        surface = warm.surface() if warm is not None else front_surface(c, body_depth)
         fluid = {"profiles": [{"x": [0.0, c.dp * math.floor(x_toe / c.dp)], "base": 0.0,
-                               "surface": surface}]}
+                               "surface": surface,
+                               "row_depth": None if warm is not None else body_depth * hn}]}
     shifting = {"method": c.shifting}
     if c.shifting_coefficient is not None:
         shifting["coefficient"] = c.shifting_coefficient
@@ -318,8 +338,8 @@ def _rheology(c: ConveyorCase) -> dict:
             "strain_rate_correction": c.strain_rate_correction}
 
 
-def build_scene(c: ConveyorCase, warm=None) -> Scene:
-    return scene_from_dict(build_scene_dict(c, warm))
+def build_scene(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> Scene:
+    return scene_from_dict(build_scene_dict(c, warm, body_depth))
 
 
 def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.ndarray):

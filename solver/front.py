@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 import xarray as xr
 
-from . import film_fit, steady
+from . import film_depth, film_fit, steady
 from .build import build_particles
 from .conveyor import ConveyorCase, build_scene, lubrication_velocity
 from .output import to_dataset
@@ -393,6 +393,26 @@ class Checkpointer:
         return True
 
 
+def start_body_depth(case: ConveyorCase, warm_state, quiet: bool = True) -> tuple[float, str]:
+    """(body depth / h_n, how it was chosen) of the lubrication start: the scheme's own
+    normal depth from the periodic film (``film_depth``) or h_n; h_n, with the reason, when
+    the film stops. NaN for the block and warm starts, which do not use it."""
+    if warm_state is not None or case.start != "lubrication":
+        return math.nan, f"not used (start: {case.start})"
+    if case.start_depth_rule == "theory":
+        return 1.0, "theory: h_n"
+    try:
+        film = film_depth.scheme_normal_depth(case)
+    except RuntimeError as exc:
+        note = f"theory: h_n, because {exc}"
+        if not quiet:
+            print(f"warning: start depth from the film not possible; {note}", file=sys.stderr)
+        return 1.0, note
+    if not quiet:
+        print(f"start depth: {film.describe()}", file=sys.stderr)
+    return film.depth, film.describe()
+
+
 def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dataset:
     """Run the case to steady state (or max_time) and return its dataset.
 
@@ -412,7 +432,8 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
                 print(f"warning: warm start not possible, {warm_note}", file=sys.stderr)
     if state is None and warm_note:
         case = replace(case, start="lubrication", warm_from=None)
-    scene = build_scene(case, state)
+    body_depth, depth_note = start_body_depth(case, state, quiet)
+    scene = build_scene(case, state, body_depth if math.isfinite(body_depth) else 1.0)
     parts = build_particles(scene)
     f = parts.kind == 0
     if state is not None:
@@ -447,6 +468,7 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         "simulated_time_s": float(runner.sim.t), "resumed_from_checkpoint": int(resumed),
         "case_yaml": case.to_yaml(),
         "warm_start": warm_note or (f"from {case.warm_from}" if case.start == "warm" else "no"),
+        "start_body_depth_h_n": body_depth, "start_depth": depth_note,
         "n_fluid": int(runner.sim.n_fluid), "n_boundary": int(runner.sim.n - runner.sim.n_fluid),
     })
     return ds

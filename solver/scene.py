@@ -59,6 +59,14 @@ class FluidProfile:
     base: float
     surface: list[tuple[float, float]]
     velocity: tuple[float, float] = (0.0, 0.0)
+    row_depth: float | None = None  # rows dz = row_depth / round(row_depth / dp) apart; null: dp
+
+    def row_spacing(self, dp: float) -> float:
+        """Vertical spacing of the fill: a column of depth ``row_depth`` holds a whole number
+        of rows exactly (no lattice rounding of its depth); dp without ``row_depth``."""
+        if self.row_depth is None:
+            return dp
+        return self.row_depth / max(round(self.row_depth / dp), 1)
 
     def top(self, x):
         pts = np.asarray(self.surface, dtype=float)
@@ -494,6 +502,8 @@ def validate(scene: Scene) -> None:
             raise SceneError(f"{key}.surface: the points must span {key}.x")
         if max(z for _, z in pr.surface) <= pr.base:
             raise SceneError(f"{key}.surface: lies entirely below {key}.base")
+        if pr.row_depth is not None and not (0.5 * scene.dp <= pr.row_depth):
+            raise SceneError(f"{key}.row_depth: must be at least dp / 2, or null, got {pr.row_depth}")
     regions = [(f"fluid.blocks[{j}]", b) for j, b in enumerate(scene.fluid.blocks)] + [
         (f"fluid.profiles[{j}]", p.bbox) for j, p in enumerate(scene.fluid.profiles)]
     for i, w in enumerate(scene.walls):
