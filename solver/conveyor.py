@@ -9,7 +9,7 @@ shape of the same area. The toe stands still in the lab frame at steady state.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -79,7 +79,7 @@ class ConveyorCase(YamlData):
     belt: Belt = field(default_factory=Belt)
     fluid_length: float = 20.0  # in h_n, of the initial block (the lubrication start keeps its area)
     start: str = "lubrication"
-    start_depth: str | None = None  # lubrication start's body: film or theory; null: film if newtonian
+    start_depth: str = "film"  # lubrication start: film (the scheme's own normal depth) or theory
     start_velocity: str = "rest"  # or lubrication: the steady film profile, belt running from t = 0
     warm_from: str | None = None  # start: warm: a front run's NetCDF (another dp) to start from
     wall_height: float = 2.5  # upstream wall, in h_n
@@ -131,14 +131,6 @@ class ConveyorCase(YamlData):
                                           eta_max=1 - 1e-6)
 
     @property
-    def start_depth_rule(self) -> str:
-        """How the lubrication start's body depth is chosen: ``film``, the scheme's own
-        normal depth (``film_depth``, newtonian only), or ``theory``, h_n."""
-        if self.start_depth is not None:
-            return self.start_depth
-        return "film" if self.newtonian else "theory"
-
-    @property
     def running_start(self) -> bool:
         """The fluid starts moving (warm start, or the lubrication velocity profile) and the
         belt runs at full speed from t = 0, without rest or ramp."""
@@ -187,12 +179,8 @@ def validate_case(c: ConveyorCase) -> None:
     if c.start == "warm" and c.start_velocity != "rest":
         raise SceneError("case.start_velocity: a warm start takes its velocities from warm_from; "
                          "leave start_velocity at rest")
-    if c.start_depth is not None and c.start_depth not in START_DEPTHS:
-        raise SceneError(f"case.start_depth: {c.start_depth!r} is not one of "
-                         f"{', '.join(START_DEPTHS)} (or null: film for a newtonian fluid)")
-    if c.start_depth == "film" and not c.newtonian:
-        raise SceneError("case.start_depth: film measures the flux of a newtonian film; use "
-                         "theory (h_n) for rheology herschel_bulkley")
+    if c.start_depth not in START_DEPTHS:
+        raise SceneError(f"case.start_depth: {c.start_depth!r} is not one of {', '.join(START_DEPTHS)}")
     if c.start == "warm" and not c.warm_from:
         raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")
@@ -233,26 +221,39 @@ def wall_thickness(c: ConveyorCase) -> float:
     return math.ceil(2.0 * c.ch - 1e-9) * c.dp
 
 
-def initial_toe(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> float:
-    """x of the toe at t = 0 (``body_depth``: the lubrication start's body depth in h_n)."""
+def scheme_fluid(c: ConveyorCase, flux_ratio: float) -> ConveyorCase:
+    """The case with the fluid whose exact film carries ``flux_ratio`` r times the real one's
+    flux, i.e. the fluid the scheme behaves as (``film_depth``): mu / r, or K r^-n for
+    Herschel-Bulkley (the film flux scales as K^(-1/n) at a fixed yield depth). Its h_n is the
+    scheme's normal depth h_s; its fluid_length is rescaled so the start keeps the area
+    fluid_length h_n h_s."""
+    if flux_ratio == 1.0:
+        return c
+    if c.newtonian:
+        s = replace(c, viscosity=c.viscosity / flux_ratio)
+    else:
+        s = replace(c, consistency=c.consistency * flux_ratio ** -c.index)
+    return replace(s, fluid_length=c.fluid_length * c.h_n / s.h_n)
+
+
+def initial_toe(c: ConveyorCase, warm=None) -> float:
+    """x of the toe at t = 0."""
     hn = c.h_n
     if warm is not None:
         return warm.toe
     if c.start == "block":
         return c.fluid_length * hn
-    hs = body_depth * hn
     if c.newtonian:
-        return c.fluid_length * hn + lubrication.front_area_deficit(c.theta) * hs
+        return (c.fluid_length + lubrication.front_area_deficit(c.theta)) * hn
     xs, eta = c.front_shape()
     deficit = float(np.sum(np.diff(xs) * (1 - 0.5 * (eta[1:] + eta[:-1]))))
-    return c.fluid_length * hn + deficit * hs
+    return (c.fluid_length + deficit) * hn
 
 
-def front_surface(c: ConveyorCase, body_depth: float = 1.0) -> list[list[float]]:
-    """Points of the lubrication front surface from the wall (x = 0) to the toe: the steady
-    front of normal depth h_s = body_depth h_n (lengths and depths scale with it), with the
-    area of a block of length fluid_length h_n at depth h_s."""
-    hn, x_toe = body_depth * c.h_n, initial_toe(c, body_depth=body_depth)
+def front_surface(c: ConveyorCase) -> list[list[float]]:
+    """Points of the lubrication front surface from the wall (x = 0) to the toe, with the
+    area of a block of length fluid_length h_n at depth h_n."""
+    hn, x_toe = c.h_n, initial_toe(c)
     xs, eta = c.front_shape()
     xi = xs * hn
     if c.newtonian:
@@ -269,14 +270,16 @@ def front_surface(c: ConveyorCase, body_depth: float = 1.0) -> list[list[float]]
     return [[float(a), float(b)] for a, b in zip(x, z)]
 
 
-def build_scene_dict(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> dict:
+def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dict:
     """The generic scene of SPEC section 2 as plain data. ``warm`` (a ``warm.WarmState``)
     gives the free surface of a warm start; without it a warm case is built with the
     lubrication shape (for validation before the run it starts from exists). The lubrication
-    start's body is ``body_depth`` h_n deep, its rows filling that depth exactly."""
+    start is the steady front of ``scheme_fluid(c, flux_ratio)``, its rows filling that
+    fluid's normal depth h_s exactly."""
     hn, th, g = c.h_n, c.theta, c.gravity
     T = wall_thickness(c)
-    x_toe = initial_toe(c, warm, body_depth)
+    start = scheme_fluid(c, flux_ratio)
+    x_toe = initial_toe(start, warm)
     rest, ramp = (0.0, 0.0) if c.running_start else (c.belt.rest, c.belt.ramp)
     belt_end = c.dp * math.ceil((x_toe + c.belt.margin * hn) / c.dp)
     wall_top = c.dp * math.ceil(c.wall_height * hn / c.dp)
@@ -293,10 +296,10 @@ def build_scene_dict(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> dic
     if c.start == "block":
         fluid = {"blocks": [{"x": [0.0, x_toe], "z": [0.0, hn]}]}
     else:
-        surface = warm.surface() if warm is not None else front_surface(c, body_depth)
+        surface = warm.surface() if warm is not None else front_surface(start)
         fluid = {"profiles": [{"x": [0.0, c.dp * math.floor(x_toe / c.dp)], "base": 0.0,
                                "surface": surface,
-                               "row_depth": None if warm is not None else body_depth * hn}]}
+                               "row_depth": None if warm is not None else start.h_n}]}
     shifting = {"method": c.shifting}
     if c.shifting_coefficient is not None:
         shifting["coefficient"] = c.shifting_coefficient
@@ -338,8 +341,8 @@ def _rheology(c: ConveyorCase) -> dict:
             "strain_rate_correction": c.strain_rate_correction}
 
 
-def build_scene(c: ConveyorCase, warm=None, body_depth: float = 1.0) -> Scene:
-    return scene_from_dict(build_scene_dict(c, warm, body_depth))
+def build_scene(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> Scene:
+    return scene_from_dict(build_scene_dict(c, warm, flux_ratio))
 
 
 def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.ndarray):

@@ -1,21 +1,24 @@
 """The scheme's own normal depth, measured on a short periodic film.
 
 The conveyor's body settles where its film, relative to the belt, carries u_b h (zero flux
-in the lab frame). An SPH film carries a flux q_SPH(h) a little off the exact
-q(h) = g sin(theta) h^3 / (3 nu) (SPEC section 7), so the scheme's body settles off h_n, and
-a start filled to h_n drains or fills its body through the front for seconds.
+in the lab frame). An SPH film carries a flux q_SPH(h) a little off the exact q(h)
+(g sin(theta) h^3 / (3 nu), SPEC section 7, or the Herschel-Bulkley film's), so the scheme's
+body settles off h_n, and a start filled to h_n drains or fills its body through the front
+for seconds.
 
 Here a film of depth h_n (rows filling it exactly), periodic in x over a strip of at least
 3 kernel supports, flows on a fixed bed under the case's gravity with every numerical choice
 of the case (dp, Ch, shifting, density diffusion, boundary, viscous term, CFL). Over
 [FILM_TIME - FILM_AVERAGE, FILM_TIME] its volume flux sum(V u) / L gives r = q_SPH / q at
-the film's mean depth; with q_SPH = r q (q ~ h^3), q_SPH(h) = u_b h at
+the film's mean depth. The scheme then behaves as the fluid whose exact film carries r q:
+viscosity mu / r (Herschel-Bulkley: consistency K r^-n), whose normal depth is
 
-    h_s = h_n / sqrt(r),
+    h_s = h_n / sqrt(r)   (newtonian; Herschel-Bulkley: zero lab-frame flux of that fluid),
 
-the body depth the lubrication start is filled to (``ConveyorCase.start_depth: film``).
-The film starts from rest; its slowest viscous mode decays with 4 h^2 / (pi^2 nu)
-(35 ms for the paper's fluid), so FILM_TIME is many of them.
+the body depth the lubrication start is filled to, with that fluid's front
+(``conveyor.scheme_fluid``; ``ConveyorCase.start_depth: film``). The film starts from rest;
+its slowest viscous mode decays with 4 h^2 / (pi^2 nu) (35 ms for the paper's fluid), so
+FILM_TIME is many of them.
 """
 from __future__ import annotations
 
@@ -25,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .conveyor import build_scene_dict, scheme_fluid, wall_thickness
 from .scene import scene_from_dict
 from .simulation import Simulation
 
@@ -47,8 +51,6 @@ class FilmDepth:
 
 def film_scene_dict(case) -> dict:
     """The periodic film of the case's scheme: depth h_n, bed fixed, strip of whole dp."""
-    from .conveyor import build_scene_dict, wall_thickness
-
     d = build_scene_dict(case)
     hn, dp = case.h_n, case.dp
     n = math.ceil(6.0 * case.ch - 1e-9) + 1  # columns: the period holds 3 kernel supports 2h
@@ -63,7 +65,7 @@ def film_scene_dict(case) -> dict:
 
 
 def scheme_normal_depth(case) -> FilmDepth:
-    """Run the film and return h_s / h_n; RuntimeError if the film stops (a guard fired)."""
+    """Run the film and return r and h_s / h_n; RuntimeError if the film stops (a guard fired)."""
     start = time.perf_counter()
     scene = scene_from_dict(film_scene_dict(case))
     sim = Simulation(scene)
@@ -79,8 +81,14 @@ def scheme_normal_depth(case) -> FilmDepth:
             depth.append(volume.sum() / length)
             flux.append((volume * sim.u[fluid]).sum() / length)
     h = float(np.mean(depth))
-    g_x = scene.gravity[0]
-    exact = g_x * h ** 3 / (3.0 * scene.fluid.viscosity / scene.fluid.density)
-    r = float(np.mean(flux)) / exact
-    return FilmDepth(depth=1.0 / math.sqrt(r), flux_ratio=r, steps=sim.steps,
+    r = float(np.mean(flux)) / exact_flux(case, h)
+    return FilmDepth(depth=scheme_fluid(case, r).h_n / case.h_n, flux_ratio=r, steps=sim.steps,
                      wall_time=time.perf_counter() - start)
+
+
+def exact_flux(case, h: float) -> float:
+    """Volume flux per unit width of the exact film of depth h on the case's slope."""
+    g, sin = case.gravity, math.sin(case.theta)
+    if case.newtonian:
+        return g * sin * h ** 3 / (3.0 * case.viscosity / case.density)
+    return case.hb_fluid.flux(h, sin, g)

@@ -143,7 +143,7 @@ class PairFields(NamedTuple):
 
 class PairConstants(NamedTuple):
     """Scene constants of the pair loop: hc0 = h c0; k_hyd = rho0 g_z / B and
-    k_col = rho0 g_z / c0^2 (g_z < 0) for the two diffusion references; dp2 = dp^2."""
+    k_col = rho0 g_z / c0^2 (g_z < 0) for the two diffusion references."""
     h: float
     nu: float
     hc0: float
@@ -151,7 +151,6 @@ class PairConstants(NamedTuple):
     k_hyd: float
     k_col: float
     delta: float
-    dp2: float
     av: float  # alpha h c0 of the artificial viscosity (0: off)
 
 
@@ -227,10 +226,10 @@ def diffusion_column(g, drab, dz, ra, rb, rho0, k_col):
 
 
 @nb.njit(inline="always", cache=True)
-def concentration_terms(dp2, F, dx, dz, rdotg):
-    """a's shares of gradC = sum_b dp^2 gradW_ab and div r = -sum_b dp^2 r_ab . gradW_ab
-    (b gets -gradC's and the same div r share)."""
-    return dp2 * F * dx, dp2 * F * dz, -dp2 * rdotg
+def concentration_terms(Vb, F, dx, dz, rdotg):
+    """a's shares of gradC = sum_b V_b gradW_ab and div r = -sum_b V_b r_ab . gradW_ab,
+    V_b = m_b / rho_b (b's shares: the same with V_a, gradC's with the opposite sign)."""
+    return Vb * F * dx, Vb * F * dz, -Vb * rdotg
 
 
 @functools.cache
@@ -267,7 +266,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         (passed one by one: numba 0.68 loses writes to arrays held in a tuple inside prange)."""
         x, z, u, w, rho, p, mass, kind = f.x, f.z, f.u, f.w, f.rho, f.p, f.mass, f.kind
         start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
-        h, nu, hc0, rho0, dp2 = k.h, k.nu, k.hc0, k.rho0, k.dp2
+        h, nu, hc0, rho0 = k.h, k.nu, k.hc0, k.rho0
         nt = split.size - 1
         fac = grad_coefficient(h)
         eta2 = 0.01 * h * h
@@ -387,12 +386,13 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                             drho_b += eb * Va
                                 at[b, DRHO] += drho_b
                                 if shifting:
-                                    sx, sz, sdiv = concentration_terms(dp2, F, dx, dz, rdotg)
+                                    sx, sz, sdiv = concentration_terms(Vb, F, dx, dz, rdotg)
                                     s_gcx += sx
                                     s_gcz += sz
+                                    s_divr += sdiv
+                                    sx, sz, sdiv = concentration_terms(Va, F, dx, dz, rdotg)
                                     at[b, GCX] -= sx
                                     at[b, GCZ] -= sz
-                                    s_divr += sdiv
                                     at[b, DIVR] += sdiv
                                     if kb == 1:
                                         s_wnx -= F * f.wnx[b]

@@ -15,7 +15,7 @@ import xarray as xr
 
 from . import film_depth, film_fit, steady
 from .build import build_particles
-from .conveyor import ConveyorCase, build_scene, lubrication_velocity
+from .conveyor import ConveyorCase, build_scene, lubrication_velocity, scheme_fluid
 from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, toe_position
 from .run import Runner
@@ -393,13 +393,14 @@ class Checkpointer:
         return True
 
 
-def start_body_depth(case: ConveyorCase, warm_state, quiet: bool = True) -> tuple[float, str]:
-    """(body depth / h_n, how it was chosen) of the lubrication start: the scheme's own
-    normal depth from the periodic film (``film_depth``) or h_n; h_n, with the reason, when
-    the film stops. NaN for the block and warm starts, which do not use it."""
+def start_flux_ratio(case: ConveyorCase, warm_state, quiet: bool = True) -> tuple[float, str]:
+    """(r, how the start's depth was chosen): r = the scheme's film flux over the exact one
+    (``film_depth``; the start is the steady front of ``conveyor.scheme_fluid(case, r)``), or
+    1 (``start_depth: theory``, or when the film stops, with the reason). NaN for the block
+    and warm starts, which do not use it."""
     if warm_state is not None or case.start != "lubrication":
         return math.nan, f"not used (start: {case.start})"
-    if case.start_depth_rule == "theory":
+    if case.start_depth == "theory":
         return 1.0, "theory: h_n"
     try:
         film = film_depth.scheme_normal_depth(case)
@@ -410,7 +411,7 @@ def start_body_depth(case: ConveyorCase, warm_state, quiet: bool = True) -> tupl
         return 1.0, note
     if not quiet:
         print(f"start depth: {film.describe()}", file=sys.stderr)
-    return film.depth, film.describe()
+    return film.flux_ratio, film.describe()
 
 
 def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dataset:
@@ -432,8 +433,9 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
                 print(f"warning: warm start not possible, {warm_note}", file=sys.stderr)
     if state is None and warm_note:
         case = replace(case, start="lubrication", warm_from=None)
-    body_depth, depth_note = start_body_depth(case, state, quiet)
-    scene = build_scene(case, state, body_depth if math.isfinite(body_depth) else 1.0)
+    flux_ratio, depth_note = start_flux_ratio(case, state, quiet)
+    used = math.isfinite(flux_ratio)
+    scene = build_scene(case, state, flux_ratio if used else 1.0)
     parts = build_particles(scene)
     f = parts.kind == 0
     if state is not None:
@@ -468,7 +470,8 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         "simulated_time_s": float(runner.sim.t), "resumed_from_checkpoint": int(resumed),
         "case_yaml": case.to_yaml(),
         "warm_start": warm_note or (f"from {case.warm_from}" if case.start == "warm" else "no"),
-        "start_body_depth_h_n": body_depth, "start_depth": depth_note,
+        "start_body_depth_h_n": scheme_fluid(case, flux_ratio).h_n / case.h_n if used else math.nan,
+        "start_flux_ratio": flux_ratio, "start_depth": depth_note,
         "n_fluid": int(runner.sim.n_fluid), "n_boundary": int(runner.sim.n - runner.sim.n_fluid),
     })
     return ds

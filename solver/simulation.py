@@ -128,7 +128,7 @@ class Simulation:
         self.constants = forces.PairConstants(
             h=self.h, nu=self.nu, hc0=self.h * self.c0, rho0=self.rho0,
             k_hyd=self.rho0 * s.gravity[1] / self.B, k_col=self.rho0 * s.gravity[1] / self.c0 ** 2,
-            delta=self.delta, dp2=s.dp * s.dp, av=(s.physics.artificial_viscosity or 0.0) * self.h * self.c0)
+            delta=self.delta, av=(s.physics.artificial_viscosity or 0.0) * self.h * self.c0)
         self.p = np.zeros(self.n)
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)

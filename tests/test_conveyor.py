@@ -13,7 +13,7 @@ import yaml
 
 from solver import lubrication
 from solver.build import build_particles
-from solver.conveyor import build_scene, case_from_dict, initial_toe, wall_thickness
+from solver.conveyor import build_scene, case_from_dict, initial_toe, scheme_fluid, wall_thickness
 from solver.scene import SceneError
 from tests.conftest import EXAMPLES
 
@@ -61,31 +61,32 @@ def test_preset_geometry(start):
         assert p.z[f].max() == pytest.approx(c.dp * (round(c.h_n / c.dp) - 0.5), abs=1e-12)
 
 
-@pytest.mark.parametrize("body", [1.0, 1.0086])
-def test_lubrication_start_fills_its_body_depth_exactly(body):
-    """The rows are dz = h_s / round(h_s / dp) apart, so the body's top edge is h_s = body h_n
-    (a dp lattice would put it at 19 dp = 1.0128 h_n at dp = 1 mm), each particle's m / rho is
-    its cell dp dz, and the fluid holds the area fluid_length h_n h_s."""
+@pytest.mark.parametrize("r", [1.0, 0.9831])
+def test_lubrication_start_fills_its_body_depth_exactly(r):
+    """The start is the steady front of the fluid the scheme behaves as (mu / r), whose
+    normal depth is h_s = h_n / sqrt(r); its rows are dz = h_s / round(h_s / dp) apart, so the
+    body's top edge is h_s (a dp lattice would put it at 19 dp = 1.0128 h_n at dp = 1 mm),
+    each particle's m / rho is its cell dp dz, and the fluid holds fluid_length h_n h_s."""
     c = paper(dp=1.0e-3)
-    p = build_particles(build_scene(c, body_depth=body))
+    start = scheme_fluid(c, r)
+    h_s = c.h_n / math.sqrt(r)
+    assert start.h_n == pytest.approx(h_s, rel=1e-12)
+    p = build_particles(build_scene(c, flux_ratio=r))
     f = p.kind == 0
     volume = p.mass[f] / p.rho[f]
     column = f & (np.abs(p.x - 10.0 * c.h_n) < 0.5 * c.dp)  # x* about 10 from the toe
     zs = np.sort(p.z[column])
-    dz = body * c.h_n / round(body * c.h_n / c.dp)
+    dz = h_s / round(h_s / c.dp)
     np.testing.assert_allclose(np.diff(zs), dz, rtol=1e-9)
-    assert zs[-1] + 0.5 * dz == pytest.approx(body * c.h_n, rel=1e-9)
+    assert zs[-1] + 0.5 * dz == pytest.approx(h_s, rel=1e-9)
     np.testing.assert_allclose(p.mass[column] / p.rho[column], c.dp * dz, rtol=1e-12)
     # each column rounds to whole rows: at most half a row
-    assert volume.sum() == pytest.approx(c.fluid_length * c.h_n * body * c.h_n,
-                                         abs=0.5 * dz * initial_toe(c, body_depth=body))
+    assert volume.sum() == pytest.approx(c.fluid_length * c.h_n * h_s, abs=0.5 * dz * initial_toe(start))
 
 
-def test_start_depth_keys_are_validated():
+def test_start_depth_is_validated():
     with pytest.raises(SceneError, match="start_depth.*film, theory"):
         paper(start_depth="exact")
-    assert paper().start_depth_rule == "film"
-    assert paper(start_depth="theory").start_depth_rule == "theory"
 
 
 def test_film_of_the_scheme_carries_the_exact_flux_to_two_percent():

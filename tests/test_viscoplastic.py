@@ -62,6 +62,29 @@ def test_conveyor_case_for_a_yield_stress_fluid():
         case_from_dict({**HB_CASE, "start_velocity": "moving"})
 
 
+def test_scheme_fluid_of_a_yield_stress_fluid_carries_r_times_the_flux():
+    """The start's fluid for a film flux ratio r (solver/conveyor.py, scheme_fluid) has
+    consistency K r^-n: its film carries r times the real film's flux at every depth and
+    slope (the yield depth does not depend on K), so its zero-flux depth is the scheme's
+    normal depth; the start keeps the area fluid_length h_n h_s."""
+    from solver.conveyor import build_scene, case_from_dict, initial_toe, scheme_fluid
+    from solver.build import build_particles
+    c = case_from_dict({**HB_CASE, "dp": 2.0e-3})
+    r = 0.73
+    s = scheme_fluid(c, r)
+    for h in (0.01, c.h_n, 0.03):
+        for S in (0.2, math.sin(THETA), 0.4):
+            assert s.hb_fluid.flux(h, S, G) == pytest.approx(r * c.hb_fluid.flux(h, S, G), rel=1e-12)
+    assert r * c.hb_fluid.flux(s.h_n, math.sin(THETA), G) == pytest.approx(U_B * s.h_n, rel=1e-9)
+    assert s.h_n > c.h_n
+    p = build_particles(build_scene(c, flux_ratio=r))
+    f = p.kind == 0
+    area = (p.mass[f] / p.rho[f]).sum()
+    # each column rounds to whole rows: at most half a row
+    dz = s.h_n / round(s.h_n / c.dp)
+    assert area == pytest.approx(c.fluid_length * c.h_n * s.h_n, abs=0.5 * dz * initial_toe(s))
+
+
 def test_lubrication_start_velocity_of_a_yield_stress_fluid():
     """The Herschel-Bulkley film at the local depth: u = -U on the belt (no slip), a plug of
     uniform velocity above h0 = h - tau_y / (rho g S), and zero lab-frame flux in every column
