@@ -20,6 +20,7 @@ class Particles:
     w: np.ndarray
     rho: np.ndarray
     mass: np.ndarray  # rho(t=0) dp dz: particle volumes match the lattice cells
+    cell_volume: np.ndarray  # dp dz, the lattice cell (dp^2 but in a profile with row_depth)
     kind: np.ndarray  # int8: 0 fluid, 1 boundary
     wall: np.ndarray  # int32: wall index, -1 for fluid
     gx: np.ndarray  # ghost node of a boundary particle
@@ -204,6 +205,7 @@ def build_particles(scene: Scene) -> Particles:
         u=np.concatenate([fu, np.zeros(nb)]), w=np.concatenate([fw, np.zeros(nb)]),
         rho=np.concatenate([frho, brho]),
         mass=np.concatenate([frho * fdz, brho * dp]) * dp,
+        cell_volume=np.concatenate([fdz * dp, np.full(nb, dp * dp)]),
         kind=np.concatenate([np.full(nf, FLUID, np.int8), np.full(nb, BOUNDARY, np.int8)]),
         wall=np.concatenate([np.full(nf, -1, np.int32), bwall]),
         gx=np.concatenate([np.full(nf, np.nan), gx]), gz=np.concatenate([np.full(nf, np.nan), gz]),

@@ -124,7 +124,8 @@ def thread_rows(start, split, t, ncx, ncz):
 
 class PairFields(NamedTuple):
     """Particle arrays the pair loop reads, in cell order. sdx, sdz: the last shift (read
-    only with the shifting density correction); wnx, wnz: inward wall normals."""
+    only with the shifting density correction); wnx, wnz: inward wall normals; cell: each
+    particle's lattice cell dp dz (the volume the shifting's concentration counts)."""
     x: np.ndarray
     z: np.ndarray
     u: np.ndarray
@@ -139,6 +140,7 @@ class PairFields(NamedTuple):
     sdz: np.ndarray
     nu_p: np.ndarray  # each particle's kinematic viscosity (read with variable_viscosity only)
     gamma: np.ndarray  # each particle's last strain rate (read with strain_correction only)
+    cell: np.ndarray  # lattice cell dp dz of each particle (read with shifting only)
 
 
 class PairConstants(NamedTuple):
@@ -226,10 +228,10 @@ def diffusion_column(g, drab, dz, ra, rb, rho0, k_col):
 
 
 @nb.njit(inline="always", cache=True)
-def concentration_terms(Vb, F, dx, dz, rdotg):
-    """a's shares of gradC = sum_b V_b gradW_ab and div r = -sum_b V_b r_ab . gradW_ab,
-    V_b = m_b / rho_b (b's shares: the same with V_a, gradC's with the opposite sign)."""
-    return Vb * F * dx, Vb * F * dz, -Vb * rdotg
+def concentration_terms(cell_b, F, dx, dz, rdotg):
+    """a's shares of gradC = sum_b c_b gradW_ab and div r = -sum_b c_b r_ab . gradW_ab, c_b
+    b's lattice cell dp dz (b's shares: the same with c_a, gradC's with the opposite sign)."""
+    return cell_b * F * dx, cell_b * F * dz, -cell_b * rdotg
 
 
 @functools.cache
@@ -386,11 +388,11 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                             drho_b += eb * Va
                                 at[b, DRHO] += drho_b
                                 if shifting:
-                                    sx, sz, sdiv = concentration_terms(Vb, F, dx, dz, rdotg)
+                                    sx, sz, sdiv = concentration_terms(f.cell[b], F, dx, dz, rdotg)
                                     s_gcx += sx
                                     s_gcz += sz
                                     s_divr += sdiv
-                                    sx, sz, sdiv = concentration_terms(Va, F, dx, dz, rdotg)
+                                    sx, sz, sdiv = concentration_terms(f.cell[a], F, dx, dz, rdotg)
                                     at[b, GCX] -= sx
                                     at[b, GCZ] -= sz
                                     at[b, DIVR] += sdiv

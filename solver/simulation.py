@@ -11,8 +11,8 @@ from .build import Particles, build_particles
 from .kernel import alpha_2d
 from .scene import Scene
 
-_SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "wnx", "wnz",
-           "pid")
+_SORTED = ("x", "z", "u", "w", "rho", "mass", "cell_volume", "drho_prev", "kind", "wall", "gx", "gz",
+           "wnx", "wnz", "pid")
 _SHIFT = ("shift_dx", "shift_dz")  # the last shift, pending its density correction
 
 
@@ -49,7 +49,7 @@ class Simulation:
         p = particles if particles is not None else build_particles(scene)
         self.n = p.n
         self.x, self.z, self.u, self.w = p.x.copy(), p.z.copy(), p.u.copy(), p.w.copy()
-        self.rho, self.mass = p.rho.copy(), p.mass.copy()
+        self.rho, self.mass, self.cell_volume = p.rho.copy(), p.mass.copy(), p.cell_volume.copy()
         self.kind, self.wall, self.pid = p.kind.copy(), p.wall.copy(), p.pid.copy()
         self.gx, self.gz = p.gx.copy(), p.gz.copy()
         # inward wall normal of each boundary particle (towards its ghost node)
@@ -188,7 +188,7 @@ class Simulation:
         forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
-                                   self.gamma_p)
+                                   self.gamma_p, self.cell_volume)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
             # more pairs than the list holds: widen it and evaluate again
