@@ -34,6 +34,7 @@ from .simulation import Simulation
 
 FILM_TIME = 0.5  # s simulated
 FILM_AVERAGE = 0.2  # s: the flux is averaged over the film's last FILM_AVERAGE seconds
+R_RANGE = (0.25, 4.0)  # a flux ratio outside is no film of this fluid (h_s would be off 2-fold)
 
 
 @dataclass
@@ -65,7 +66,8 @@ def film_scene_dict(case) -> dict:
 
 
 def scheme_normal_depth(case) -> FilmDepth:
-    """Run the film and return r and h_s / h_n; RuntimeError if the film stops (a guard fired)."""
+    """Run the film and return r and h_s / h_n; RuntimeError if the film stops (a guard fired)
+    or r falls outside R_RANGE."""
     start = time.perf_counter()
     scene = scene_from_dict(film_scene_dict(case))
     sim = Simulation(scene)
@@ -82,6 +84,8 @@ def scheme_normal_depth(case) -> FilmDepth:
             flux.append((volume * sim.u[fluid]).sum() / length)
     h = float(np.mean(depth))
     r = float(np.mean(flux)) / exact_flux(case, h)
+    if not R_RANGE[0] <= r <= R_RANGE[1]:  # NaN included
+        raise RuntimeError(f"the film's flux ratio {r:.4g} lies outside {list(R_RANGE)}")
     return FilmDepth(depth=scheme_fluid(case, r).h_n / case.h_n, flux_ratio=r, steps=sim.steps,
                      wall_time=time.perf_counter() - start)
 

@@ -14,9 +14,9 @@ Ch = 1.8), each step moves an interior fluid particle's density towards its pack
     lambda = beta c0 dt / h                        (a rate beta c0 / h per second),
 
 so that loose packing (C < C_0) lowers the pressure and draws the particles together, and
-crowding raises it. Interior: h |gradC| < GRAD_MAX with the shifting's gradC = sum_b dp^2
-gradW_ab (small inside the fluid, large at a free surface, where C < C_0 is the truncated
-kernel, not loose packing).
+crowding raises it. Interior: h |gradC| < GRAD_MAX with the shifting's gradC = sum_b c_b
+gradW_ab, c_b b's lattice cell (small inside the fluid, large at a free surface, where
+C < C_0 is the truncated kernel, not loose packing).
 """
 from __future__ import annotations
 

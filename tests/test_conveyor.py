@@ -100,6 +100,17 @@ def test_film_of_the_scheme_carries_the_exact_flux_to_two_percent():
     assert film.depth == pytest.approx(film.flux_ratio ** -0.5, rel=1e-12)
 
 
+def test_start_falls_back_to_h_n_when_the_film_stops():
+    """A scheme whose film diverges (C_CFL 5) starts at h_n and says why; the block start
+    does not run the film at all."""
+    from solver.front import start_flux_ratio
+
+    r, note = start_flux_ratio(paper(dp=4.0e-3, ch=1.5, cfl=5.0), None)
+    assert r == 1.0 and note.startswith("theory: h_n, because the film stopped")
+    r, note = start_flux_ratio(paper(start="block"), None)
+    assert math.isnan(r) and "not used" in note
+
+
 def test_fast_example_is_the_paper_case_with_its_documented_settings():
     """examples/conveyor_fast.yaml differs from conveyor.yaml only in the settings that
     docs/conveyor.md measures ("A steady answer in two minutes"), and builds a valid scene."""
