@@ -86,9 +86,10 @@ def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None,
     cs, zs = col[order], z[order]
     # top of each contiguous run (same column, gaps of at most 1.5 rows)
     n = zs.size
-    run_top = zs + 0.5 * dz[order]
+    rows = dz[order]
+    run_top = zs + 0.5 * rows
     for i in range(n - 2, -1, -1):
-        if cs[i + 1] == cs[i] and zs[i + 1] - zs[i] < 1.5 * dz[order][i]:
+        if cs[i + 1] == cs[i] and zs[i + 1] - zs[i] < 1.5 * rows[i]:
             run_top[i] = run_top[i + 1]
     out = np.full(qx.size, -np.inf)
     qcol = np.round(qx / dp).astype(np.int64)

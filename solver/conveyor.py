@@ -3,8 +3,9 @@
 Lab frame, x downslope along the belt, z bed-normal, gravity g (sin theta, -cos theta).
 The belt is the bottom wall z < 0, fixed particles carrying the velocity -u_b (upslope),
 ramped from 0 after a rest; a fixed wall closes the upstream end at x = 0. The fluid starts
-as a block of depth h_n and length ``fluid_length`` h_n, or with the lubrication front
-shape of the same area. The toe stands still in the lab frame at steady state.
+as a block of depth h_n and length ``fluid_length`` h_n, or as the steady lubrication front
+of the fluid the scheme behaves as (``scheme_fluid``; ``start_depth``), of area
+fluid_length h_n h_s. The toe stands still in the lab frame at steady state.
 """
 from __future__ import annotations
 
