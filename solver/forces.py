@@ -228,10 +228,11 @@ def diffusion_column(g, drab, dz, ra, rb, rho0, k_col):
 
 
 @nb.njit(inline="always", cache=True)
-def concentration_terms(cell_b, F, dx, dz, rdotg):
-    """a's shares of gradC = sum_b c_b gradW_ab and div r = -sum_b c_b r_ab . gradW_ab, c_b
-    b's lattice cell dp dz (b's shares: the same with c_a, gradC's with the opposite sign)."""
-    return cell_b * F * dx, cell_b * F * dz, -cell_b * rdotg
+def concentration_terms(F, dx, dz, rdotg):
+    """gradW_ab and -r_ab . gradW_ab: times c_b (b's lattice cell dp dz) they are a's shares of
+    gradC = sum_b c_b gradW_ab and div r = -sum_b c_b r_ab . gradW_ab; times c_a, b's shares
+    (gradC's with the opposite sign)."""
+    return F * dx, F * dz, -rdotg
 
 
 @functools.cache
@@ -310,6 +311,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             xa, za, ua, wa = x[a], z[a], u[a], w[a]
                             ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
                             Va = ma / ra
+                            cell_a = f.cell[a]
                             ira = 1.0 / ra
                             s_ax = s_az = s_drho = 0.0
                             s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
@@ -388,14 +390,14 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                             drho_b += eb * Va
                                 at[b, DRHO] += drho_b
                                 if shifting:
-                                    sx, sz, sdiv = concentration_terms(f.cell[b], F, dx, dz, rdotg)
-                                    s_gcx += sx
-                                    s_gcz += sz
-                                    s_divr += sdiv
-                                    sx, sz, sdiv = concentration_terms(f.cell[a], F, dx, dz, rdotg)
-                                    at[b, GCX] -= sx
-                                    at[b, GCZ] -= sz
-                                    at[b, DIVR] += sdiv
+                                    gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
+                                    cell_b = f.cell[b]
+                                    s_gcx += cell_b * gx
+                                    s_gcz += cell_b * gz
+                                    s_divr += cell_b * gdiv
+                                    at[b, GCX] -= cell_a * gx
+                                    at[b, GCZ] -= cell_a * gz
+                                    at[b, DIVR] += cell_a * gdiv
                                     if kb == 1:
                                         s_wnx -= F * f.wnx[b]
                                         s_wnz -= F * f.wnz[b]
