@@ -51,6 +51,8 @@ VARIANTS = {
     "cfl_0.3_average_1s": ["cfl=0.3", "steady.average=1.0"],
     # examples/conveyor_fast.yaml's settings (the file lists them and why)
     "fast": example_overrides("conveyor_fast"),
+    # the same with the 1 s averaging window that examples/conveyor_fast.yaml now ships
+    "fast_average_1s": example_overrides("conveyor_fast") + ["steady.average=1.0"],
 }
 
 

@@ -134,7 +134,12 @@ def assess(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: fl
     return {"steady": bool(ok), "ratio": ratio, "lower": lower}
 
 
-SPANS = (1, 2, 4, 8)  # trailing spans tried, in windows: a longer span resolves a noisier trend
+# trailing spans tried, in windows: a longer span resolves a noisier trend. Every whole number
+# of windows up to 8, so that a noisy signal is declared at the first span long enough to
+# resolve its noise (not at the next power of two); the spans are nested, each containing the
+# shorter ones, so their fits are strongly correlated and trying all of them raises the
+# chance that a drift beyond its tolerance passes only a little (tests/test_steady.py)
+SPANS = tuple(range(1, 9))
 
 
 def is_steady(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
