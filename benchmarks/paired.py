@@ -1,8 +1,11 @@
 """Compare solver throughput of two source trees, alternately, in one run (the machine is noisy).
 
 Each round runs ``benchmarks/throughput.py`` of the current tree with PYTHONPATH set to the
-old tree, then to the new one (the benchmark script is the same for both, so the scene is
-the same), and prints one JSON line per measurement with a "tree" key.
+old tree and to the new one (the benchmark script is the same for both, so the scene is the
+same), and prints one JSON line per measurement with "round", "tree" and "order" (0: run
+first in its round) keys. The order alternates from round to round: on this host the tree
+run second read 8-16 % lower even for identical code, so compare the trees over an even
+number of rounds, or within the same order.
 
 Usage: python benchmarks/paired.py OLD_TREE [NEW_TREE=.] [--rounds 2] [throughput.py args...]
 Example: git worktree add /tmp/base <commit>; python benchmarks/paired.py /tmp/base --ch 1.5 --threads 2
@@ -33,10 +36,11 @@ def main(argv=None):
     a, rest = ap.parse_known_args(argv)
     for tree in (a.old, a.new):  # compile both before timing
         run_tree(tree, rest + ["--steps", "1"])
+    pair = [("old", a.old), ("new", a.new)]
     for r in range(a.rounds):
-        for label, tree in (("old", a.old), ("new", a.new)):
+        for order, (label, tree) in enumerate(pair if r % 2 == 0 else pair[::-1]):
             for row in run_tree(tree, rest):
-                print(json.dumps({"round": r, "tree": label, **row}), flush=True)
+                print(json.dumps({"round": r, "tree": label, "order": order, **row}), flush=True)
 
 
 if __name__ == "__main__":
