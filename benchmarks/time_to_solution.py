@@ -49,9 +49,10 @@ VARIANTS = {
     "average_1s": ["steady.average=1.0"],
     "cfl_0.3": ["cfl=0.3"],
     "cfl_0.3_average_1s": ["cfl=0.3", "steady.average=1.0"],
-    # examples/conveyor_fast.yaml's settings (the file lists them and why)
+    # examples/conveyor_fast.yaml's scheme settings (the file lists them and why) with
+    # conveyor.yaml's 2 s averaging window
     "fast": example_overrides("conveyor_fast"),
-    # the same with the 1 s averaging window that examples/conveyor_fast.yaml now ships
+    # examples/conveyor_fast.yaml as shipped: its scheme settings and its 1 s averaging window
     "fast_average_1s": example_overrides("conveyor_fast") + ["steady.average=1.0"],
 }
 
