@@ -234,7 +234,7 @@ def test_noisy_station_velocity_without_drift_is_steady_on_a_longer_window():
 def test_noisy_station_velocity_is_detected_at_the_first_span_that_resolves_it():
     """The same noise and no drift: every whole span from 1 to 8 windows is tried, so most
     realisations are declared on a span shorter than 8 windows, before min_time + 8 windows
-    = 8.5 s (measured: 15 of these 20 verified windows start at 6.0-8.4 s; with spans of 1, 2,
+    = 8.5 s (measured: 15 of these 20 verified windows start at 6.16-8.28 s; with spans of 1, 2,
     4 and 8 windows only, none could)."""
     crit = SteadyCriteria(window=1.0, min_time=0.5, dp=2.25e-3)
     early = 0
