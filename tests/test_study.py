@@ -11,7 +11,7 @@ import yaml
 
 from study import config as cfgmod
 from study.grid import CASE_ID, case_id, expand, fmt
-from study.metrics import case_metrics, rms_difference
+from study.metrics import case_metrics, rms_difference, zeta_f_error
 from study.reference import read_velocity_csv, theory
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -245,3 +245,23 @@ def test_warm_start_chains_each_case_to_the_next_coarser_dp(tmp_path):
     coarse = out.index("front results/cases/dp3mm_ch1.5_lind/case.yaml")
     fine = out.index("front results/cases/dp2mm_ch1.5_lind/case.yaml")
     assert coarse < fine
+
+
+def test_zeta_f_error_is_the_scatter_of_the_last_second_toe_slope():
+    """The toe steady but for white noise of 0.5 mm, sampled every 0.02 s: zeta_f_error (the
+    slope's standard error over the last second, over u_b) matches the spread of the slopes
+    fitted over 300 realisations within 20 %, and what the toe did before the last second
+    (a 5 cm jump) does not enter it."""
+    u_b, sigma = 0.075, 5e-4
+    t = np.arange(0.0, 3.0 + 1e-9, 0.02)
+    last = t >= t[-1] - 1.0 - 1e-9
+    rng = np.random.default_rng(1)
+    errs, slopes = [], []
+    for _ in range(300):
+        toe = 0.4 + rng.normal(0.0, sigma, t.size)
+        errs.append(zeta_f_error(t, toe, u_b))
+        slopes.append(np.polyfit(t[last], toe[last], 1)[0] / u_b)
+        toe_jump = toe + np.where(t < 1.5, 0.05, 0.0)
+        assert zeta_f_error(t, toe_jump, u_b) == errs[-1]
+    spread = float(np.std(slopes))
+    assert 0.8 * spread < float(np.median(errs)) < 1.2 * spread, (spread, np.median(errs))

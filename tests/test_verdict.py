@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from campaign_data import campaign
 from study.verdict import extrapolate, verdicts
@@ -109,3 +110,29 @@ def test_extrapolation_and_the_dp_needed():
     assert extrapolate(dp, 0.001 + dp).dp_needed == 0.001  # already met at the finest dp
     assert extrapolate(dp, [0.03, 0.02, 0.025]).status == "oscillatory"
     assert extrapolate(dp, -0.002 + 10 * dp).extrapolated == 0.0  # a limit below 0 means "vanishes"
+
+
+def test_a_zeta_f_within_its_sampling_error_of_the_threshold_is_not_below_it():
+    """The paper-like campaign (zeta_f 0.6-0.7 % at the finest dp) with a sampling error of
+    zeta_f of 0.3 %: 2 se = 0.6 % reaches past 1 %, so the claim is not reproduced, and lind's
+    zeta_f (half skillen's) is a tie with skillen's; with 0.1 % it is reproduced again."""
+    ds = campaign(paper_like)
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.003)
+    v = by_claim(ds)
+    assert v["zeta_f"].verdict == "not reproduced"
+    assert "± 0.6 % (2 se)" in v["zeta_f"].evidence
+    assert "zeta_f: lind" in v["lind_better"].evidence and "(tie)" in v["lind_better"].evidence
+    assert v["lind_better"].verdict == "not reproduced"
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.001)
+    v = by_claim(ds)
+    assert v["zeta_f"].verdict == "reproduced" and v["lind_better"].verdict == "reproduced"
+
+
+def test_zeta_f_is_not_ruled_out_within_its_sampling_error():
+    """The opposite campaign (skillen's zeta_f 3.5 % at the finest dp, tending to 3 %) is
+    contradicted; with a sampling error of 1.5 % (2 se = 3 %) no Ch's zeta_f lies above 1 %
+    by more than 2 se: not reproduced."""
+    ds = campaign(opposite)
+    assert by_claim(ds)["zeta_f"].verdict == "contradicted"
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.015)
+    assert by_claim(ds)["zeta_f"].verdict == "not reproduced"

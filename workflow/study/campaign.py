@@ -9,7 +9,7 @@ import xarray as xr
 from . import stability
 from .grid import Case
 
-SCALARS = ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_fs_measured")
+SCALARS = ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_fs_measured")
 RUN_NUMBERS = {
     "wall_time": ("wall_time_s", "s", "wall-clock time of the run"),
     "steps": ("steps", "1", "time steps"),
@@ -81,7 +81,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
             continue
         ix = (dps.index(c.dp), chs.index(c.ch), shs.index(c.shifting))
         for k in SCALARS:
-            data[k][ix] = float(m[k])
+            data[k][ix] = float(m[k]) if k in m else np.nan  # metrics written before zeta_f_se
         data["zeta_u"][ix] = m["zeta_u"].values
         data["zeta_u_measured"][ix] = m["zeta_u_measured"].values
         for k, (attr, _, _) in RUN_NUMBERS.items():
@@ -118,7 +118,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
                 "station": ("station", stations, {"units": "1", "long_name": "station x*"}),
                 "x_star": ("x_star", x_star, {"units": "1"}), "z_star": ("z_star", z_star, {"units": "1"})})
     for k in SCALARS:
-        ds[k].attrs.update(metrics[0][k].attrs)
+        ds[k].attrs.update(metrics[0][k].attrs if k in metrics[0] else {})
     for k in ("zeta_u", "zeta_u_measured"):
         ds[k].attrs.update(metrics[0][k].attrs)
     for k, (_, units, long) in RUN_NUMBERS.items():
@@ -143,7 +143,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     for k, (attr, units, _) in RUN_NUMBERS.items():
         ds[f"case_{k}"] = ("case", [float(r.attrs.get(attr, np.nan)) for r in runs], {"units": units})
     for k in SCALARS:
-        ds[f"case_{k}"] = ("case", [float(m[k]) for m in metrics])
+        ds[f"case_{k}"] = ("case", [float(m[k]) if k in m else np.nan for m in metrics])
     ds["case_zeta_u"] = (("case", "station"), np.stack([m["zeta_u"].values for m in metrics]))
     # stability: margins to each guard, the detector that fired, the swept settings
     marg = [stability.margins(r) for r in runs]

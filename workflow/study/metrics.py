@@ -15,6 +15,19 @@ def zeta_f(front_velocity: float, u_b: float) -> float:
     return abs(front_velocity) / u_b
 
 
+def zeta_f_error(t, toe, u_b: float) -> float:
+    """Standard error of zeta_f from the toe's own scatter: se of the least-squares toe slope
+    over the last second of the record (the second zeta_f is measured over), widened for the
+    residuals' lag-1 correlation (solver.steady.trend_bound), over u_b. NaN with < 4 samples."""
+    from solver.steady import trend_bound
+    t = np.asarray(t, dtype=float)
+    if t.size < 4:
+        return float("nan")
+    last = t >= t[-1] - 1.0 - 1e-9
+    _, se = trend_bound(t[last], np.asarray(toe, dtype=float)[last])
+    return se / u_b
+
+
 def zeta_h(depth: float, h_ref: float) -> float:
     """|h*_u - h*_n| / h*_n with both depths normalised by h_ref."""
     return abs(depth - h_ref) / h_ref
@@ -59,7 +72,7 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     over its final window, flagged by ``steady = 0`` (the report and figures mark them).
     """
     st = ref["station"].values
-    out = {k: np.nan for k in ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs")}
+    out = {k: np.nan for k in ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_paper", "zeta_fs")}
     zu = np.full(st.size, np.nan)
     meas = {"zeta_fs_measured": np.nan}
     zu_meas = np.full(st.size, np.nan)
@@ -68,6 +81,8 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         hn = float(run.attrs["h_n_m"])
         ub = float(run.attrs["belt_speed_m_s"])
         out["zeta_f"] = zeta_f(float(run["front_velocity"]), ub)
+        if "toe_position" in run:  # the probe record (absent from hand-made means-only runs)
+            out["zeta_f_se"] = zeta_f_error(run["time"].values, run["toe_position"].values, ub)
         depth = float(run["mean_uniform_depth"])
         out["zeta_h"] = zeta_h(depth, hn)
         out["zeta_h_paper"] = zeta_h(depth, float(run.attrs["normalising_depth_m"]))
@@ -93,6 +108,7 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     ds["steady"].attrs.update(units="1", long_name="1: metrics over a steady window; 0: not steady or no metrics")
     attrs = {
         "zeta_f": "front velocity error |u*_f - u*_b| / u*_b",
+        "zeta_f_se": "standard error of zeta_f from the toe's scatter over its second",
         "zeta_h": "uniform depth error against the computed h_n",
         "zeta_h_paper": "uniform depth error against the paper's normalising depth",
         "zeta_fs": "free-surface RMS error against the theory",

@@ -11,6 +11,8 @@ Verdicts:
   the extrapolation does not rule the threshold out);
 - ``no data``: the runs the claim needs are missing or diverged.
 A verdict whose evidence includes runs that were not steady says so (``unsteady``).
+A metric with a sampling error in the campaign dataset (``zeta_f_se``) is below or above a
+threshold only by more than 2 se, and two runs within 2 se of each other tie.
 """
 from __future__ import annotations
 
@@ -123,8 +125,20 @@ def _mm(dp):
     return f"{dp * 1000:g} mm"
 
 
+def _se(ds, var, dp, ch, sh) -> float:
+    """The sampling standard error of ``var`` at one run (``{var}_se`` in the campaign
+    dataset), 0 where the campaign has none."""
+    if f"{var}_se" not in ds:
+        return 0.0
+    se = float(ds[f"{var}_se"].sel(dp=dp, ch=ch, shifting=sh))
+    return se if np.isfinite(se) else 0.0
+
+
 def threshold_claim(ds, var, threshold, chs, sh, need, claim):
-    """``var`` below ``threshold`` at the finest dp for at least ``need`` of ``chs``."""
+    """``var`` below ``threshold`` at the finest dp for at least ``need`` of ``chs``. A value
+    with a sampling error (``{var}_se``) counts as below only when it is below by more than
+    2 se; it counts as ruled out only when it is above by more than 2 se and the GCI limit
+    minus its band is above as well."""
     met, ruled_out, parts, sels = 0, 0, [], []
     for ch in chs:
         da = _series(ds, var, ch, sh)
@@ -134,13 +148,15 @@ def threshold_claim(ds, var, threshold, chs, sh, need, claim):
             continue
         x = extrapolate(da["dp"].values, da.values, threshold)
         v = float(da.sel(dp=dp))
+        two_se = 2.0 * _se(ds, var, dp, ch, sh)
         sels.append(dict(dp=dp, ch=ch, shifting=sh))
-        if v < threshold:
+        if v + two_se < threshold:
             met += 1
-        elif x.status == "monotone" and x.extrapolated - x.band > threshold:
+        elif v - two_se > threshold and x.status == "monotone" and x.extrapolated - x.band > threshold:
             ruled_out += 1
         note = f" (limit {_pct(x.extrapolated)} ± {_pct(x.band)})" if x.status == "monotone" else ""
-        parts.append(f"Ch {ch:g}: {_pct(v)} at {_mm(dp)}{note}")
+        noise = f" ± {_pct(two_se)} (2 se)" if two_se > 0 else ""
+        parts.append(f"Ch {ch:g}: {_pct(v)}{noise} at {_mm(dp)}{note}")
     if not sels:
         return Verdict(claim, "no data", "no finished run", [], [])
     need = min(need, len(chs))
@@ -151,6 +167,8 @@ def threshold_claim(ds, var, threshold, chs, sh, need, claim):
     else:
         verdict = "not reproduced"
     evidence = f"{sh}: " + "; ".join(parts) + f". Below {_pct(threshold)}: {met} of {len(chs)} Ch"
+    if "2 se" in evidence:
+        evidence += " (by more than 2 se)"
     return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
 
 
@@ -238,14 +256,16 @@ def _both_methods(ds, quantities):
 
 def lind_better_claim(ds, claim):
     """Lind below Skillen on zeta_f and zeta_h at the paper's Ch, at the finest dp where both
-    finished. A difference below RESOLVED of the larger value is a tie."""
+    finished. A difference below RESOLVED of the larger value, or within 2 se of the two
+    values' sampling errors combined (``{var}_se``), is a tie."""
     ch, dp, why_not = _both_methods(ds, [("zeta_f", None), ("zeta_h", None)])
     if dp is None:
         return Verdict(claim, "no data", why_not, [], [])
     better, worse, parts = 0, 0, []
     for var in ("zeta_f", "zeta_h"):
         lv, sv = (_value(ds, var, dp, ch, s) for s in ("lind", "skillen"))
-        if abs(lv - sv) <= RESOLVED * max(lv, sv):
+        two_se = 2.0 * math.hypot(_se(ds, var, dp, ch, "lind"), _se(ds, var, dp, ch, "skillen"))
+        if abs(lv - sv) <= max(RESOLVED * max(lv, sv), two_se):
             word = "tie"
         elif lv < sv:
             word, better = "lind better", better + 1
