@@ -265,3 +265,5 @@ def test_zeta_f_error_is_the_scatter_of_the_last_second_toe_slope():
         assert zeta_f_error(t, toe_jump, u_b) == errs[-1]
     spread = float(np.std(slopes))
     assert 0.8 * spread < float(np.median(errs)) < 1.2 * spread, (spread, np.median(errs))
+    coarse = t[::25]  # probes every 0.5 s: 3 samples in the last second, no scatter to measure
+    assert math.isnan(zeta_f_error(coarse, 0.4 + rng.normal(0.0, sigma, coarse.size), u_b))
