@@ -14,7 +14,7 @@ laminar term, solver/implicit.py), where C may exceed the explicit edge; the CG 
 step are reported.
 
 Usage: python benchmarks/viscous_limit.py [--dp 0.00025] [--ch 1.8] [--c 0.2 0.25 0.3 0.35 0.42]
-           [--end 0.3] [--threads 2] [--implicit]
+           [--end 0.3] [--threads 2] [--implicit] [--physics KEY=VALUE ...]
 """
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ from solver.simulation import Simulation
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def film(dp: float, ch: float, end: float, update: str = "explicit") -> dict:
+def film(dp: float, ch: float, end: float, update: str = "explicit", physics=()) -> dict:
     d = yaml.safe_load((ROOT / "examples" / "film.yaml").read_text())
     H = 0.01876
     L = 24 * dp
@@ -44,6 +44,13 @@ def film(dp: float, ch: float, end: float, update: str = "explicit") -> dict:
     d["walls"] = [{"name": "bed", "x": [0.0, L], "z": [-T, 0.0]}]
     d["time"] = {"end": end, "output_interval": end}
     d.setdefault("physics", {})["viscous_update"] = update
+    for item in physics:  # KEY=VALUE, KEY dotted below physics, VALUE in YAML
+        key, value = item.split("=", 1)
+        *path, last = key.split(".")
+        node = d["physics"]
+        for k in path:
+            node = node.setdefault(k, {})
+        node[last] = yaml.safe_load(value)
     return d
 
 
@@ -59,8 +66,8 @@ def exact_error(sim: Simulation) -> float:
     return float(np.sqrt(np.mean((u - exact) ** 2)) / (g / s.nu * 0.5 * H * H))
 
 
-def run(dp: float, ch: float, C: float, end: float, update: str = "explicit") -> dict:
-    sim = Simulation(scene_from_dict(film(dp, ch, end, update)))
+def run(dp: float, ch: float, C: float, end: float, update: str = "explicit", physics=()) -> dict:
+    sim = Simulation(scene_from_dict(film(dp, ch, end, update, physics)))
     dt = C * sim.h ** 2 / sim.nu
     acoustic = 0.2 * sim.h / sim.c0
     steps = int(math.ceil(end / dt))
@@ -71,7 +78,8 @@ def run(dp: float, ch: float, C: float, end: float, update: str = "explicit") ->
         if reason:
             break
     wall = time.perf_counter() - tic
-    return {"dp": dp, "ch": ch, "update": update, "C": C, "dt": dt, "acoustic_dt": acoustic, "steps": sim.steps,
+    return {"dp": dp, "ch": ch, "update": update, "physics": list(physics), "C": C, "dt": dt,
+            "acoustic_dt": acoustic, "acoustic_C": round(dt * sim.c0 / sim.h, 3), "steps": sim.steps,
             "t": sim.t, "status": "diverged" if reason else "bounded", "reason": reason,
             "u_rms_error": math.nan if reason else exact_error(sim), "wall_s": round(wall, 1),
             "particles": sim.n, "cg_iterations_per_step": round(sim.solver_iterations / max(sim.steps, 1), 1)}
@@ -85,10 +93,13 @@ def main(argv=None):
     ap.add_argument("--end", type=float, default=0.3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--implicit", action="store_true", help="physics.viscous_update: implicit")
+    ap.add_argument("--physics", nargs="*", default=[], metavar="KEY=VALUE",
+                    help="scene physics settings, e.g. viscous_correction=true shifting.method=skillen")
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
     for C in a.c:
-        print(json.dumps(run(a.dp, a.ch, C, a.end, "implicit" if a.implicit else "explicit")), flush=True)
+        print(json.dumps(run(a.dp, a.ch, C, a.end, "implicit" if a.implicit else "explicit", a.physics)),
+              flush=True)
 
 
 if __name__ == "__main__":
