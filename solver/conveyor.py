@@ -66,6 +66,9 @@ class ConveyorCase(YamlData):
     shift_density_correction: bool | None = None  # null: the method's default
     shift_correction_limit: float | None = None  # null: the method's default
     shift_max: float | None = None  # clip of each shift component in dp; null: the scene default
+    # skillen: the shift's speed is max(|u|, shift_min_speed u_b) (0: SPEC's |u|); not used by
+    # the other methods, so that one campaign grid holds both
+    shift_min_speed: float = 0.0
     density: float = 1383.0
     viscosity: float = 5.6  # mu [Pa s] of a newtonian fluid (not used by herschel_bulkley)
     rheology: str = "newtonian"  # or herschel_bulkley (the scene's fluid keys below)
@@ -165,6 +168,9 @@ def validate_case(c: ConveyorCase) -> None:
         positive(getattr(c, key), f"case.{key}")
     if c.cfl_viscous is not None:
         positive(c.cfl_viscous, "case.cfl_viscous")
+    if not (c.shift_min_speed >= 0 and math.isfinite(c.shift_min_speed)):
+        raise SceneError(f"case.shift_min_speed: must be a finite number >= 0 (a fraction of the belt "
+                         f"speed), got {c.shift_min_speed!r}")
     if c.newtonian and c.strain_rate_correction:
         raise SceneError("case.strain_rate_correction: only for rheology herschel_bulkley")
     if c.viscous_update not in VISCOUS_UPDATES:
@@ -308,6 +314,8 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
                        ("correction_limit", c.shift_correction_limit), ("max_shift", c.shift_max)):
         if value is not None:
             shifting[key] = value
+    if c.shift_min_speed and c.shifting == "skillen":
+        shifting["min_speed"] = c.shift_min_speed * c.belt.speed
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,

@@ -149,6 +149,8 @@ class Shifting:
     # limit of |div(dr)| per step in that correction; null: the method's default (lind 1e-3,
     # skillen none), 0 or a negative value is rejected
     correction_limit: float | None = None
+    # skillen: the speed in dr = -A h |u| dt gradC is max(|u|, min_speed) [m/s] (0: SPEC's |u|)
+    min_speed: float = 0.0
 
 
 @dataclass
@@ -480,6 +482,11 @@ def validate(scene: Scene) -> None:
     _positive(sh.max_shift, "physics.shifting.max_shift")
     if sh.correction_limit is not None:
         _positive(sh.correction_limit, "physics.shifting.correction_limit")
+    if not (sh.min_speed >= 0 and math.isfinite(sh.min_speed)):
+        raise SceneError(f"physics.shifting.min_speed: must be a finite number >= 0 [m/s], got {sh.min_speed!r}")
+    if sh.min_speed > 0 and sh.method != "skillen":
+        raise SceneError(f"physics.shifting.min_speed: applies to method skillen only (its shift scales "
+                         f"with |u|), got method {sh.method!r}")
     if not 0 < sh.surface_threshold < 2:
         raise SceneError(
             f"physics.shifting.surface_threshold: must lie in (0, 2), got {sh.surface_threshold}")

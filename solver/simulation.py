@@ -262,7 +262,7 @@ class Simulation:
         if self.shift_method == "skillen":
             shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.wall_s0,
                                    self.n_active, A, self.h, dt, sh.surface_threshold, clip,
-                                   self.shift_dx, self.shift_dz)
+                                   sh.min_speed, self.shift_dx, self.shift_dz)
         elif self.shift_method == "lind":
             shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.cells,
                                   self.n_active, self.h, sh.surface_threshold, shifting.SCAN_UPPER,

@@ -120,7 +120,7 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
     with open(EXAMPLES / "conveyor_fast.yaml") as fh:
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
-    assert changed == {"name", "shifting", "viscous_correction", "start_velocity", "cfl",
+    assert changed == {"name", "shifting", "shift_min_speed", "viscous_correction", "start_velocity", "cfl",
                        "cfl_viscous", "volume_relaxation", "density_diffusion_reference", "steady"}
     own = ("max_time", "average")  # the fast example averages over 1 s (measured in docs/conveyor.md)
     assert {k: v for k, v in fast_d["steady"].items() if k not in own} == \
@@ -129,6 +129,7 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
     fast = case_from_dict(fast_d)
     assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
     assert (fast.cfl, fast.cfl_viscous) == (0.4, 0.2)
+    assert fast.shift_min_speed == 0.5
     assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
     assert fast.h_n == paper().h_n
     build_scene(replace(fast, dp=4.0e-3, ch=1.5))
@@ -145,6 +146,17 @@ def test_case_errors_name_the_key():
         paper(shiftng="lind")
     with pytest.raises(SceneError, match="physics.shifting.method"):
         paper(shifting="magic")
+    with pytest.raises(SceneError, match="case.shift_min_speed"):
+        paper(shift_min_speed=-0.5)
+
+
+def test_shift_min_speed_is_a_fraction_of_the_belt_speed_for_skillen_only():
+    """One campaign grid holds both methods: the floor reaches skillen's scene as
+    shift_min_speed u_b [m/s] and is not passed to lind, whose shift does not scale with |u|."""
+    skillen = build_scene(paper(shifting="skillen", shift_min_speed=0.5, dp=4.0e-3))
+    assert skillen.physics.shifting.min_speed == pytest.approx(0.5 * 0.075)
+    lind = build_scene(paper(shifting="lind", shift_min_speed=0.5, dp=4.0e-3))
+    assert lind.physics.shifting.min_speed == 0.0
 
 
 @pytest.mark.slow

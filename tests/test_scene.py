@@ -45,6 +45,10 @@ def test_impossible_values():
     assert "physics.shifting.method" in err({"physics": {"shifting": {"method": "magic"}}})
     assert "none, skillen, lind" in err({"physics": {"shifting": {"method": "magic"}}})
     assert "physics.boundary" in err({"physics": {"boundary": "slip"}})
+    assert "physics.shifting.min_speed: must be a finite number >= 0" in err(
+        {"physics": {"shifting": {"method": "skillen", "min_speed": -0.1}}})
+    assert "applies to method skillen only" in err(
+        {"physics": {"shifting": {"method": "lind", "min_speed": 0.05}}})
     assert "fluid.blocks[0].x" in err({"fluid": {"blocks": [{"x": [1e-3, 0.0], "z": [0.0, 1e-3]}]}})
 
 

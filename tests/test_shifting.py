@@ -81,6 +81,37 @@ def test_shifting_reduces_disorder(method):
     assert after < 0.5 * before, (before, after)
 
 
+def disordered_channel_at_rest(min_speed):
+    scene = example_scene("channel", physics={"shifting": {"method": "skillen", "density_correction": False,
+                                                            "min_speed": min_speed}})
+    parts = build_particles(scene)
+    f = parts.kind == 0
+    rng = np.random.default_rng(7)
+    parts.x[f] += rng.uniform(-0.2, 0.2, f.sum()) * scene.dp
+    parts.z[f] += rng.uniform(-0.2, 0.2, f.sum()) * scene.dp
+    parts.u[:] = parts.w[:] = 0.0
+    return scene, Simulation(scene, parts)
+
+
+def test_skillen_speed_floor_orders_fluid_at_rest():
+    """Skillen's shift scales with |u|: fluid at rest (in this frame) is never reordered, whatever
+    its disorder. With ``min_speed`` the speed is max(|u|, min_speed), and the same disordered
+    fluid at rest is ordered as the moving one above (30 shifts, each over 0.1 h of travel at
+    min_speed)."""
+    results = {}
+    for floor in (0.0, U):
+        scene, sim = disordered_channel_at_rest(floor)
+        period = scene.periodic_x[1]
+        before = disorder(sim.x, sim.z, sim.kind, period, scene.dp)
+        for _ in range(30):
+            sim.shift_only(0.1 * scene.h / U)
+        results[floor] = before, disorder(sim.x, sim.z, sim.kind, period, scene.dp)
+    before, after = results[0.0]
+    assert after == pytest.approx(before, rel=1e-12)  # |u| = 0: no shift at all
+    before, after = results[U]
+    assert after < 0.5 * before, (before, after)
+
+
 def test_shifting_off_leaves_disorder():
     """Control for the test above: with method none the same shifting calls move nothing."""
     scene = example_scene("channel")
