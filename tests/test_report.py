@@ -23,6 +23,19 @@ def test_the_report_opens_with_the_verdict():
     assert "dp for 1 %" in text and "mm</td>" in text  # the dp needed, in mm
 
 
+def test_the_case_table_gives_zeta_f_with_its_sampling_error():
+    """zeta_f is shown as value +- 2 se where the run carries its standard error, alone where
+    it does not (metrics written before the error was kept)."""
+    from study.report import case_table
+    ds = campaign(paper_like)
+    ds["case_zeta_f"][:] = 0.0077
+    ds["case_zeta_f_se"] = xr.full_like(ds["case_zeta_f"], 0.0105)
+    ds["case_zeta_f_se"][0] = np.nan
+    table = case_table(ds)
+    assert table.count("0.0077 &plusmn; 0.021") == ds.sizes["case"] - 1
+    assert "zeta_f (± 2 se)" in table
+
+
 def test_a_yield_stress_campaign_is_not_judged_against_the_newtonian_paper():
     """The paper's conclusions concern a Newtonian fluid: a Herschel-Bulkley campaign's report
     says so instead of giving verdicts on them."""

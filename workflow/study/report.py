@@ -49,10 +49,17 @@ def _commit() -> str:
         return "unknown"
 
 
+def _with_error(value, se) -> str:
+    """value +- 2 se (the sampling error of zeta_f), or the value alone where se is unknown."""
+    if se is None or not np.isfinite(se):
+        return _fmt(value)
+    return f"{_fmt(value)} &plusmn; {_fmt(2.0 * se)}"
+
+
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
     head = ["case", "status", "steady", "wall time [s]", "steps", "particles", "steady at [s]",
-            "zeta_f", "zeta_h (h_n)", "zeta_h (paper)", "zeta_fs"] + [f"zeta_u x*={s:g}" for s in st]
+            "zeta_f (± 2 se)", "zeta_h (h_n)", "zeta_h (paper)", "zeta_fs"] + [f"zeta_u x*={s:g}" for s in st]
     rows = []
     for i, cid in enumerate(ds["case"].values):
         status = str(ds["case_status"].values[i])
@@ -61,8 +68,11 @@ def case_table(ds: xr.Dataset) -> str:
                  f'<td class="l" title="{html.escape(reason)}">{html.escape(status)}'
                  + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>",
                  f'<td>{"yes" if int(ds["case_steady"].values[i]) else "no"}</td>']
-        for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time",
-                  "case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
+        for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time"):
+            cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
+        se = ds["case_zeta_f_se"].values[i] if "case_zeta_f_se" in ds else None
+        cells.append(f"<td>{_with_error(ds['case_zeta_f'].values[i], se)}</td>")
+        for k in ("case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
             cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
         for j in range(st.size):
             cells.append(f"<td>{_fmt(ds['case_zeta_u'].values[i, j])}</td>")
