@@ -2,9 +2,12 @@
 
 skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - thr)/(2 - thr)
          up to div r = 2, each component clipped to max_shift dp. With ``min_speed`` > 0 the
-         speed is max(|u_a|, min_speed): |u_a| depends on the frame, and where the lab-frame
-         velocity passes through zero inside a sheared layer SPEC's shift vanishes while the
-         shear keeps disordering the particles (docs/numerics.md, "Skillen's speed floor").
+         speed is max(|u_a|, min_speed) where no wall particle is within 2h: |u_a| depends on
+         the frame, and where the lab-frame velocity passes through zero inside a sheared layer
+         SPEC's shift vanishes while the shear keeps disordering the particles. Within reach of
+         a wall SPEC's |u_a| stays: slow fluid there is a stagnant corner (a free surface
+         against a wall), which a floored shift pulls apart (docs/numerics.md, "Skillen's speed
+         floor").
 lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp; no shift for
          particles within 2h of a free-surface particle (div r < thr, or a scan-region test
          where thr <= div r < 1.9, see free_surface).
@@ -67,15 +70,18 @@ def _off_wall(dx, dz, nx, nz, s0):
 @nb.njit(parallel=True, cache=True)
 def skillen_shift(kind, u, w, gcx, gcz, divr, wnx, wnz, s0, n_active, A, h, dt, thr, clip, min_speed,
                   dx_out, dz_out):
-    """dr = -A h max(|u|, min_speed) dt f gradC, f = min((div r - thr) / (2 - thr), 1), zero
-    below thr, each component clipped, never into a wall (``_off_wall``)."""
+    """dr = -A h s dt f gradC, f = min((div r - thr) / (2 - thr), 1), zero below thr, each
+    component clipped, never into a wall (``_off_wall``); s = max(|u|, min_speed) where no
+    wall particle is within reach (the kernel-weighted wall-normal sum is zero), else |u|."""
     for i in nb.prange(n_active):
         dx_out[i] = 0.0
         dz_out[i] = 0.0
         if kind[i] != 0 or divr[i] < thr:
             continue
         f = min((divr[i] - thr) / (2.0 - thr), 1.0)
-        speed = max(math.sqrt(u[i] * u[i] + w[i] * w[i]), min_speed)
+        speed = math.sqrt(u[i] * u[i] + w[i] * w[i])
+        if wnx[i] == 0.0 and wnz[i] == 0.0:
+            speed = max(speed, min_speed)
         c = -A * h * speed * dt * f
         dx_out[i], dz_out[i] = _off_wall(min(max(c * gcx[i], -clip), clip),
                                          min(max(c * gcz[i], -clip), clip), wnx[i], wnz[i], s0)

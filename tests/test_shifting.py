@@ -22,15 +22,17 @@ def moving_channel(method, **physics):
                          physics={"shifting": {"method": method, **physics}})
 
 
-def disorder(x, z, kind, period, dp):
-    """Std of nearest-neighbour distances of fluid particles, in dp (periodic in x)."""
+def disorder(x, z, kind, period, dp, among=None):
+    """Std of nearest-neighbour distances of fluid particles (or of the fluid particles where
+    ``among`` is true), in dp (periodic in x)."""
     f = kind == 0
     dx = x[f][:, None] - x[f][None, :]
     dx -= period * np.round(dx / period)
     dz = z[f][:, None] - z[f][None, :]
     d = np.hypot(dx, dz)
     np.fill_diagonal(d, np.inf)
-    return d.min(axis=1).std() / dp
+    nearest = d.min(axis=1)
+    return (nearest if among is None else nearest[among[f]]).std() / dp
 
 
 @pytest.mark.parametrize("method, correction, bound", [
@@ -93,23 +95,34 @@ def disordered_channel_at_rest(min_speed):
     return scene, Simulation(scene, parts)
 
 
-def test_skillen_speed_floor_orders_fluid_at_rest():
+def test_skillen_speed_floor_orders_the_interior_of_fluid_at_rest():
     """Skillen's shift scales with |u|: fluid at rest (in this frame) is never reordered, whatever
-    its disorder. With ``min_speed`` the speed is max(|u|, min_speed), and the same disordered
-    fluid at rest is ordered as the moving one above (30 shifts, each over 0.1 h of travel at
-    min_speed)."""
+    its disorder. With ``min_speed`` the speed is max(|u|, min_speed) where no wall is within 2h,
+    and there the same disordered fluid at rest is ordered as the
+    moving one above (30 shifts, each over 0.1 h of travel at min_speed); the rows within reach
+    of a wall keep SPEC's |u| = 0 and do not move."""
     results = {}
     for floor in (0.0, U):
         scene, sim = disordered_channel_at_rest(floor)
-        period = scene.periodic_x[1]
-        before = disorder(sim.x, sim.z, sim.kind, period, scene.dp)
+        period, dp, top = scene.periodic_x[1], scene.dp, scene.fluid.blocks[0].z[1]
+        pid0 = sim.pid.copy()
+        x0 = dict(zip(pid0, sim.x)), dict(zip(pid0, sim.z))
+        interior = (sim.z > 4.0 * dp) & (sim.z < top - 4.0 * dp)  # > 2h + 2 dp from both walls
+        ids = set(sim.pid[interior])
+        before = disorder(sim.x, sim.z, sim.kind, period, dp, among=interior)
         for _ in range(30):
             sim.shift_only(0.1 * scene.h / U)
-        results[floor] = before, disorder(sim.x, sim.z, sim.kind, period, scene.dp)
-    before, after = results[0.0]
+        interior = np.array([p in ids for p in sim.pid])
+        wall_rows = (sim.kind == 0) & ((sim.z < 2.0 * dp) | (sim.z > top - 2.0 * dp))
+        moved = max((abs(sim.x[i] - x0[0][sim.pid[i]]) + abs(sim.z[i] - x0[1][sim.pid[i]])
+                     for i in np.flatnonzero(wall_rows)), default=np.nan)
+        results[floor] = before, disorder(sim.x, sim.z, sim.kind, period, dp, among=interior), moved
+    before, after, moved = results[0.0]
     assert after == pytest.approx(before, rel=1e-12)  # |u| = 0: no shift at all
-    before, after = results[U]
+    assert moved == 0.0
+    before, after, moved = results[U]
     assert after < 0.5 * before, (before, after)
+    assert moved == 0.0  # within reach of a wall: |u| = 0, not the floor
 
 
 def test_shifting_off_leaves_disorder():
