@@ -327,8 +327,7 @@ class FrontMonitor:
                 ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name=long_name)
             d = steady.drifts(tw, ds.toe_position.values[win], ds.uniform_depth.values[win],
                               self.station_means()[win], tw[-1] - tw[0])
-            last_second = tw >= tw[-1] - 1.0 - 1e-9
-            ds["front_velocity"] = ((), steady.trend(tw[last_second], ds.toe_position.values[win][last_second]),
+            ds["front_velocity"] = ((), steady.front_velocity_fit(tw, ds.toe_position.values[win])[0],
                                     {"units": "m s-1",
                                      "long_name": "toe velocity over the last second of the window, lab frame"})
             ds.attrs["average_window_s"] = float(tw[-1] - tw[0])

@@ -76,6 +76,17 @@ def trend_bound(t, y) -> tuple[float, float]:
     return slope, math.sqrt(var)
 
 
+FRONT_VELOCITY_SPAN = 1.0  # s: zeta_f's toe velocity is averaged over one second (SPEC section 4)
+
+
+def front_velocity_fit(t, toe) -> tuple[float, float]:
+    """(toe slope, its standard error) over the last FRONT_VELOCITY_SPAN of the samples
+    (``trend_bound``): the front velocity of zeta_f and its sampling error."""
+    t = np.asarray(t, dtype=float)
+    last = t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9
+    return trend_bound(t[last], np.asarray(toe, dtype=float)[last])
+
+
 def window_mask(t: np.ndarray, t_end: float, window: float) -> np.ndarray:
     return (t >= t_end - window - 1e-12) & (t <= t_end + 1e-12)
 

@@ -18,17 +18,13 @@ def zeta_f(front_velocity: float, u_b: float) -> float:
 def zeta_f_error(t, toe, u_b: float) -> float:
     """Standard error of zeta_f from the toe's own scatter: se of the least-squares toe slope
     over the last second of the record (the second zeta_f is measured over), widened for the
-    residuals' lag-1 correlation (solver.steady.trend_bound), over u_b. NaN with fewer than 4
-    samples in that second (no scatter to measure)."""
-    from solver.steady import trend_bound
+    residuals' lag-1 correlation (solver.steady.front_velocity_fit), over u_b. NaN with fewer
+    than 4 samples in that second (no scatter to measure)."""
+    from solver.steady import FRONT_VELOCITY_SPAN, front_velocity_fit
     t = np.asarray(t, dtype=float)
-    if t.size == 0:
+    if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
         return float("nan")
-    last = t >= t[-1] - 1.0 - 1e-9
-    if last.sum() < 4:
-        return float("nan")
-    _, se = trend_bound(t[last], np.asarray(toe, dtype=float)[last])
-    return se / u_b
+    return front_velocity_fit(t, toe)[1] / u_b
 
 
 def zeta_h(depth: float, h_ref: float) -> float:
