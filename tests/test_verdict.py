@@ -136,3 +136,21 @@ def test_zeta_f_is_not_ruled_out_within_its_sampling_error():
     assert by_claim(ds)["zeta_f"].verdict == "contradicted"
     ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.015)
     assert by_claim(ds)["zeta_f"].verdict == "not reproduced"
+
+
+def test_a_zeta_f_whose_sampling_error_is_unknown_decides_nothing():
+    """A run whose zeta_f_se is NaN (too few toe samples to measure it): the paper-like
+    campaign, reproduced with se = 0.1 %, is not reproduced, contradicted neither, when the
+    finest runs' se is unknown; lind against skillen ties on zeta_f."""
+    ds = campaign(paper_like)
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.001)
+    assert by_claim(ds)["zeta_f"].verdict == "reproduced"
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], np.nan)
+    v = by_claim(ds)
+    assert v["zeta_f"].verdict == "not reproduced"
+    assert "(sampling error unknown)" in v["zeta_f"].evidence
+    assert "zeta_f: lind" in v["lind_better"].evidence and "tie: sampling error unknown" in v["lind_better"].evidence
+    assert v["lind_better"].verdict == "not reproduced"
+    ds = campaign(opposite)
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], np.nan)
+    assert by_claim(ds)["zeta_f"].verdict == "not reproduced"  # contradicted with se = 0

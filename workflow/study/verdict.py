@@ -12,7 +12,9 @@ Verdicts:
 - ``no data``: the runs the claim needs are missing or diverged.
 A verdict whose evidence includes runs that were not steady says so (``unsteady``).
 A metric with a sampling error in the campaign dataset (``zeta_f_se``) is below or above a
-threshold only by more than 2 se, and two runs within 2 se of each other tie.
+threshold only by more than 2 se, and two runs within 2 se of each other tie; a run whose
+sampling error could not be measured (NaN: too few toe samples) is neither below nor above,
+and ties.
 """
 from __future__ import annotations
 
@@ -127,11 +129,11 @@ def _mm(dp):
 
 def _se(ds, var, dp, ch, sh) -> float:
     """The sampling standard error of ``var`` at one run (``{var}_se`` in the campaign
-    dataset), 0 where the campaign has none."""
+    dataset): 0 where the campaign has no such variable, NaN where the run's could not be
+    measured."""
     if f"{var}_se" not in ds:
         return 0.0
-    se = float(ds[f"{var}_se"].sel(dp=dp, ch=ch, shifting=sh))
-    return se if np.isfinite(se) else 0.0
+    return float(ds[f"{var}_se"].sel(dp=dp, ch=ch, shifting=sh))
 
 
 def threshold_claim(ds, var, threshold, chs, sh, need, claim):
@@ -150,12 +152,15 @@ def threshold_claim(ds, var, threshold, chs, sh, need, claim):
         v = float(da.sel(dp=dp))
         two_se = 2.0 * _se(ds, var, dp, ch, sh)
         sels.append(dict(dp=dp, ch=ch, shifting=sh))
-        if v + two_se < threshold:
-            met += 1
-        elif v - two_se > threshold and x.status == "monotone" and x.extrapolated - x.band > threshold:
-            ruled_out += 1
+        if not np.isfinite(two_se):  # neither below nor above
+            noise = " (sampling error unknown)"
+        else:
+            if v + two_se < threshold:
+                met += 1
+            elif v - two_se > threshold and x.status == "monotone" and x.extrapolated - x.band > threshold:
+                ruled_out += 1
+            noise = f" ± {_pct(two_se)} (2 se)" if two_se > 0 else ""
         note = f" (limit {_pct(x.extrapolated)} ± {_pct(x.band)})" if x.status == "monotone" else ""
-        noise = f" ± {_pct(two_se)} (2 se)" if two_se > 0 else ""
         parts.append(f"Ch {ch:g}: {_pct(v)}{noise} at {_mm(dp)}{note}")
     if not sels:
         return Verdict(claim, "no data", "no finished run", [], [])
@@ -265,7 +270,9 @@ def lind_better_claim(ds, claim):
     for var in ("zeta_f", "zeta_h"):
         lv, sv = (_value(ds, var, dp, ch, s) for s in ("lind", "skillen"))
         two_se = 2.0 * math.hypot(_se(ds, var, dp, ch, "lind"), _se(ds, var, dp, ch, "skillen"))
-        if abs(lv - sv) <= max(RESOLVED * max(lv, sv), two_se):
+        if not np.isfinite(two_se):
+            word = "tie: sampling error unknown"
+        elif abs(lv - sv) <= max(RESOLVED * max(lv, sv), two_se):
             word = "tie"
         elif lv < sv:
             word, better = "lind better", better + 1
