@@ -1,12 +1,12 @@
 """Where a conveyor run's time goes: cProfile of the paper case, one row per function.
 
-Runs examples/conveyor.yaml (with --set overrides) for --time seconds of simulated time on
+Runs a conveyor case file (--case, default examples/conveyor.yaml; with --set overrides) for --time seconds of simulated time on
 --threads threads after a short compile run, profiles the whole front run (probes,
 monitors, guards and Python glue included) and prints a Markdown table of the functions
 with the most own time per step, then the run's particle-steps/s beside the throughput
 layer's (benchmarks/throughput.py) at the same particle count, Ch and method.
 
-Usage: python benchmarks/profile_case.py [--time 0.4] [--threads 2] [--set shifting=skillen]
+Usage: python benchmarks/profile_case.py [--case FILE] [--time 0.4] [--threads 2] [--set shifting=skillen]
            [--rows 14] [--steps-layer 400]
 """
 from __future__ import annotations
@@ -26,6 +26,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--case", type=Path, default=ROOT / "examples" / "conveyor.yaml")
     ap.add_argument("--time", type=float, default=0.4)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--set", action="append", default=[])
@@ -39,8 +40,8 @@ def main(argv=None):
     from solver.scene import read_yaml
     from throughput import measure
 
-    d = apply_overrides(read_yaml(ROOT / "examples" / "conveyor.yaml"), a.set)
-    d["steady"]["max_time"] = 0.02
+    d = apply_overrides(read_yaml(a.case), a.set)
+    d.setdefault("steady", {})["max_time"] = 0.02
     run_front(case_from_dict(d))  # compile
     d["steady"]["max_time"] = a.time
     case = case_from_dict(d)
