@@ -18,7 +18,8 @@ L_CHANNEL = 1.0e-3
 # (measured, bound) at t = 0.6 s: the L2 error falls to 2.10 % at 1.2 s and stays at 2.0-2.2 %
 # to 3 s, so the issue's 2 % is not met at this resolution (hb_film_fine.yaml meets it); the
 # bound is the measurement plus 20 %.
-# Measured with the explicit update (0.0251) and with the example's implicit one (0.02505).
+# Measured with the explicit update (0.0251) and with the example's implicit one (0.02505 at
+# cfl 0.2, 0.02500 at the example's cfl 0.4).
 HB_FILM_L2 = (0.0251, 0.030)
 # the computed plug is 6 % thinner than the exact 7.73 mm (5.6 % at 1.2 s): measured value
 # and the allowed deviation from it
@@ -94,8 +95,8 @@ def test_power_law_channel():
 def test_herschel_bulkley_film():
     """Carbopol-like film (tau_y = 20 Pa, K = 10 Pa s^n, n = 0.4) on the 15.3 deg incline.
     Velocity: see HB_FILM_L2. Plug: every particle above the exact yield surface h0 moves
-    within 1 % of the exact plug velocity (measured 0.75 % with the example's implicit
-    viscosity, 0.73 % explicit); the computed yield surface (where the particle stress
+    within 1 % of the exact plug velocity (measured 0.77 % with the example's implicit
+    viscosity at cfl 0.4, 0.75 % at cfl 0.2, 0.73 % explicit); the computed yield surface (where the particle stress
     mu(gamma) gamma falls to tau_y) lies HB_FILM_YIELD above h0."""
     err, plug_speed, plug_error = film_errors("hb_film")
     assert err < HB_FILM_L2[1], (err, HB_FILM_L2)
@@ -129,9 +130,10 @@ def test_effective_viscosity_law():
 @pytest.mark.slow
 def test_herschel_bulkley_film_at_forty_particles_meets_the_targets():
     """hb_film_fine.yaml: 40 particles across, mu_max 105 times the bed viscosity, the
-    corrected strain rate, implicit viscosity, to 1.2 s. Targets: L2 error below 2 % of the
-    plug velocity (measured 1.48 %; 1.50-1.66 % from 1.5 s to 3 s) and the computed plug
-    within 5 % of the exact 7.73 mm (measured -1.5 %; -1.2 to -1.7 % to 3 s). Every particle
+    corrected strain rate, implicit viscosity at cfl 0.4, to 1.2 s. Targets: L2 error below
+    2 % of the plug velocity (measured 1.47 %; 1.48 % at cfl 0.2, and 1.50-1.66 % from 1.5 s
+    to 3 s) and the computed plug within 5 % of the exact 7.73 mm (measured -1.5 %; -1.2 to
+    -1.7 % to 3 s at cfl 0.2). Every particle
     above the exact yield surface moves within 2.5 % of the plug velocity (measured 1.92 %:
     the capped plug creeps by rho g sin(theta) (H - h0)^2 / (2 mu_max) = 0.4 %, and the
     yielded layer still over-shears by about 1 %)."""
