@@ -110,6 +110,26 @@ def test_extrapolation_and_the_dp_needed():
     assert extrapolate(dp, 0.001 + dp).dp_needed == 0.001  # already met at the finest dp
     assert extrapolate(dp, [0.03, 0.02, 0.025]).status == "oscillatory"
     assert extrapolate(dp, -0.002 + 10 * dp).extrapolated == 0.0  # a limit below 0 means "vanishes"
+    x = extrapolate(dp, 0.2 * dp ** 0.3)  # order 0.3: 2.5 % at 1 mm, no asymptotic range
+    assert x.status == "monotone" and x.order == pytest.approx(0.3)
+    assert math.isnan(x.dp_needed)  # not 1e-3 (0.4)^(1/0.3) = 47 um, nor any other dp
+
+
+def test_the_cheapest_run_under_a_threshold_honours_the_sampling_error():
+    """zeta_f of the paper-like campaign (skillen 0.6-0.7 % and lind 0.3-0.35 % at dp = 1 mm,
+    the only runs below 1 %): with 2 se = 0.2 % the cheapest run under 1 % is one of them; with
+    2 se = 0.8 % none is, and where the se is unknown none is either."""
+    from study.verdict import accuracy_rows
+    ds = campaign(paper_like)
+    ds["case_zeta_f_se"] = xr.full_like(ds["case_zeta_f"], 0.001)
+    row = next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_f")
+    case, _, value, two_se = row["cheapest"][0.01]
+    assert value + two_se < 0.01 and two_se == pytest.approx(0.002)
+    for se in (0.004, np.nan):
+        ds["case_zeta_f_se"] = xr.full_like(ds["case_zeta_f"], se)
+        row = next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_f")
+        assert row["cheapest"][0.01] is None
+        assert (row["cheapest"][0.05] is not None) == (se == 0.004)  # 0.7 % + 0.8 % is below 5 %
 
 
 def test_a_zeta_f_within_its_sampling_error_of_the_threshold_is_not_below_it():

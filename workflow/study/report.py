@@ -142,7 +142,7 @@ def verdict_table(ds: xr.Dataset) -> str:
 def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
     """Per metric: the cheapest steady run under each threshold, and per shifting method at
     the paper's Ch the GCI-extrapolated value, its band and the dp needed for 1 %."""
-    from .verdict import accuracy_rows
+    from .verdict import MIN_ORDER, accuracy_rows
     rows = accuracy_rows(ds, thresholds)
     out, last = [], None
     for r in rows:
@@ -151,12 +151,14 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
         cells = [f'<td class="l">{html.escape(r["metric"]) if first else ""}</td>']
         for thr in thresholds:
             c = r["cheapest"][thr]
-            txt = "none" if c is None else f"{c[0]} ({c[1]:.0f} s, {c[2]:.3g})"
+            txt = "none" if c is None else (f"{c[0]} ({c[1]:.0f} s, {c[2]:.3g}"
+                                            + ("" if c[3] is None else f" ± {c[3]:.2g}") + ")")
             cells.append(f'<td class="l">{html.escape(txt) if first else ""}</td>')
         x = r["extrapolation"]
         if x.status == "monotone":
             lim = f"{_fmt(x.extrapolated)} &plusmn; {_fmt(x.band, 2)} (p = {x.order:.2g})"
-            need = ("never (limit above 1 %)" if not np.isfinite(x.dp_needed)
+            need = (f"&ndash; (order below {MIN_ORDER:g}: not converging yet)" if np.isnan(x.dp_needed)
+                    else "never (limit above 1 %)" if not np.isfinite(x.dp_needed)
                     else f"{x.dp_needed * 1000:.3g} mm")
         else:
             lim, need = html.escape(x.status), "&ndash;"
@@ -169,9 +171,11 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
             + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
             "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
     return ("<p>The cheapest steady run (wall time, error) meeting each threshold over the whole "
-            "grid; then, at the paper's Ch, the metric at the finest dp, its Richardson limit with "
-            "the GCI band of the finest value (Celik et al. 2008; only for monotone sequences over "
-            "the three finest dp) and the dp at which zeta = limit + C dp^p reaches 1 %.</p>"
+            "grid (zeta_f, with its sampling error: below by more than 2 se); then, at the paper's "
+            "Ch, the metric at the finest dp, its Richardson limit with the GCI band of the finest "
+            "value (Celik et al. 2008; only for monotone sequences over the three finest dp) and "
+            "the dp at which zeta = limit + C dp^p reaches 1 % (not projected from an observed "
+            f"order p below {MIN_ORDER:g}).</p>"
             f"<table>{head}{''.join(out)}</table>")
 
 

@@ -29,6 +29,8 @@ from .convergence import gci
 PAPER_CH = 1.8
 PAPER_FINEST_DP = 0.25e-3
 RESOLVED = 0.10  # a difference between two runs below this fraction of the larger is a tie
+# an observed order below this is no asymptotic convergence: no dp is projected from it
+MIN_ORDER = 0.5
 MARGINAL_U = 0.01  # |delta zeta_u| below which shifting "marginally" affects zeta_u (1 % of u_b)
 
 
@@ -49,7 +51,8 @@ class Extrapolation:
     extrapolated: float = math.nan
     band: float = math.nan  # absolute uncertainty of the finest value: GCI_fine |finest|
     order: float = math.nan
-    dp_needed: float = math.nan  # dp [m] at which the metric reaches the target; inf: never
+    dp_needed: float = math.nan  # dp [m] at which the metric reaches the target; inf: never;
+    # NaN: not projected (an order below MIN_ORDER)
 
 
 def main_method(ds: xr.Dataset) -> str:
@@ -71,7 +74,9 @@ def _finite_dp(da: xr.DataArray) -> xr.DataArray:
 
 def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
     """GCI of a metric over dp; the dp at which phi(dp) = phi_ext + C dp^p reaches ``target``.
-    The metrics are errors, never negative: a negative Richardson limit is reported as 0."""
+    The metrics are errors, never negative: a negative Richardson limit is reported as 0. An
+    observed order below MIN_ORDER is not projected (dp_needed NaN): such a sequence is not in
+    its asymptotic range, and dp^p with p near 0 would put the target at absurdly small dp."""
     dp = np.asarray(dp, dtype=float)
     phi = np.asarray(phi, dtype=float)
     ok = np.isfinite(dp) & np.isfinite(phi)
@@ -87,6 +92,8 @@ def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
     out.band = r.gci_fine * abs(out.finest)
     if out.finest <= target:
         out.dp_needed = float(dp[i1])
+    elif r.order < MIN_ORDER:
+        pass
     elif out.extrapolated >= target:
         out.dp_needed = math.inf
     else:
@@ -364,8 +371,10 @@ METRICS = (("zeta_f", None), ("zeta_h", None), ("zeta_h_paper", None), ("zeta_fs
 
 def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
     """Per metric (zeta_u per station) and shifting method at the paper's Ch: the cheapest
-    steady run meeting each threshold (over the whole grid), the GCI limit and band, and the
-    dp that the observed order says is needed for 1 %."""
+    steady run meeting each threshold (over the whole grid; a metric with a sampling error,
+    ``{var}_se``, meets it only when below by more than 2 se), the GCI limit and band, and the
+    dp that the observed order says is needed for 1 %. ``cheapest[thr]`` is None or (case,
+    wall time, value, 2 se or None)."""
     from .pareto import cheapest_meeting
     ch = paper_ch(ds)
     cost = np.where(ds["case_steady"].values > 0, ds["case_wall_time"].values, np.nan)
@@ -375,10 +384,13 @@ def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
         for x in stations:
             label = var if x is None else f"{var} (x* = {x:g})"
             err = ds[f"case_{var}"].values if x is None else ds["case_zeta_u"].sel(station=x).values
+            two_se = 2.0 * ds[f"case_{var}_se"].values if x is None and f"case_{var}_se" in ds else None
+            bound = err if two_se is None else err + two_se  # NaN where the se is unknown
             cheapest = {}
             for thr in thresholds:
-                i = cheapest_meeting(cost, err, thr)
-                cheapest[thr] = None if i is None else (str(ds["case"].values[i]), float(cost[i]), float(err[i]))
+                i = cheapest_meeting(cost, bound, thr)
+                cheapest[thr] = None if i is None else (str(ds["case"].values[i]), float(cost[i]), float(err[i]),
+                                                        None if two_se is None else float(two_se[i]))
             for sh in ds["shifting"].values:
                 da = _series(ds, var, ch, sh, x)
                 rows.append(dict(metric=label, shifting=str(sh), ch=ch, cheapest=cheapest,
