@@ -228,7 +228,7 @@ def fig_plug_map(ds, ch):
         if ok.any():
             ax.scatter(x[ok & (y > 0.5)], z[ok & (y > 0.5)], s=4, color=COLOURS[3], label="yielded")
             ax.scatter(x[ok & (y < 0.5)], z[ok & (y < 0.5)], s=4, color=COLOURS[0], label="unyielded (plug)")
-            ax.legend(fontsize=7, loc="upper left")
+            ax.legend(fontsize=7, loc="upper right")  # above the toe, where there is no fluid
             ax.set_aspect("equal")
         else:
             ax.text(0.5, 0.5, "no yield stress in this campaign (or no final state)",
