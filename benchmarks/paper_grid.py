@@ -4,12 +4,15 @@ Measures, on --threads threads, short runs (--time s of simulated time each, aft
 run) of the paper case (examples/conveyor.yaml with the paper grid's settings):
   - every Ch of the grid with each method at dp = 1 mm (the step rate per Ch and method),
   - Ch = 1.8 at dp = 0.5 mm and 0.25 mm with each method (how the rate and dt scale).
-Each gives particles N, steps, mean dt and particle-steps/s. A case of the grid then costs
-  wall = T_sim / dt(dp, Ch) * N(dp) / rate(dp, Ch, method)
+Each gives particles N, steps, mean dt, particle-steps/s of the time stepping (the run's own
+wall time) and the start-up (the rest: building the scene and the start's periodic film). A
+case of the grid then costs
+  wall = start-up(dp, method) + T_sim / dt(dp, Ch) * N(dp) / rate(dp, Ch, method)
 with dt and N measured at (dp, Ch = 1.8) and scaled to other Ch by the dp = 1 mm runs
 (dt and rate ratios between Ch at dp = 1 mm), and T_sim the simulated time a case needs:
-its steady time plus averaging window (--t-sim, per method, measured at dp = 1 mm: see
-benchmarks/time_to_solution.py) and, as the upper bound, the grid's max_time.
+its steady time plus averaging window (--t-sim: METHOD=T for every dp, METHOD@DP_MM=T for
+one dp; measured with benchmarks/time_to_solution.py or a front run) and, as the upper
+bound, the grid's max_time.
 
 With --set KEY=VALUE (case keys, e.g. viscous_update=implicit cfl=0.4) every run takes
 those settings; with viscous_update=implicit the dt scaling drops the viscous limit.
@@ -45,12 +48,13 @@ def measure(dp: float, ch: float, method: str, sim_time: float, settings: dict |
     tic = time.perf_counter()
     ds = run_front(case_from_dict(d))
     wall = time.perf_counter() - tic
+    stepping = float(ds.attrs["wall_time_s"])  # the run's own loop, without the start-up
     steps = int(ds.attrs["steps"])
     n = int(ds.attrs["n_fluid"]) + int(ds.attrs["n_boundary"])
     return {"dp": dp, "ch": ch, "shifting": method, "particles": n, "steps": steps,
             "simulated": float(ds.attrs["simulated_time_s"]), "wall": wall,
-            "dt": float(ds.attrs["simulated_time_s"]) / steps,
-            "rate": n * steps / wall, "c0": float(ds.attrs["c0"])}
+            "startup": wall - stepping, "dt": float(ds.attrs["simulated_time_s"]) / steps,
+            "rate": n * steps / stepping, "c0": float(ds.attrs["c0"])}
 
 
 def main(argv=None):
@@ -73,7 +77,7 @@ def main(argv=None):
     chs = grid["grid"]["ch"]
     paper_ch = grid["grid"].get("paper_ch", 1.8)
     max_time = grid["case"]["steady"]["max_time"]
-    t_sim = {k: float(v) for k, v in (s.split("=") for s in a.t_sim)}
+    t_sim = {k: float(v) for k, v in (s.split("=") for s in a.t_sim)}  # "skillen" or "skillen@0.5"
     if a.reuse:
         runs = json.loads((out / "runs.json").read_text())
     else:
@@ -86,11 +90,12 @@ def main(argv=None):
             runs.append(measure(0.0005, paper_ch, method, a.time, settings))
             runs.append(measure(0.00025, paper_ch, method, a.fine_time, settings))
         (out / "runs.json").write_text(json.dumps(runs, indent=1))
-    print("| dp [mm] | Ch | shifting | particles | simulated [s] | steps | dt [s] | wall [s] | M particle-steps/s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| dp [mm] | Ch | shifting | particles | simulated [s] | steps | dt [s] | wall [s] | start-up [s] | "
+          "M particle-steps/s |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for r in runs:
         print(f"| {r['dp'] * 1e3:g} | {r['ch']:g} | {r['shifting']} | {r['particles']} | {r['simulated']:.3f} | "
-              f"{r['steps']} | {r['dt']:.3g} | {r['wall']:.1f} | {r['rate'] / 1e6:.2f} |")
+              f"{r['steps']} | {r['dt']:.3g} | {r['wall']:.1f} | {r['startup']:.1f} | {r['rate'] / 1e6:.2f} |")
 
     def run_of(dp, ch, m):
         return next(r for r in runs if r["dp"] == dp and r["ch"] == ch and r["shifting"] == m)
@@ -121,15 +126,19 @@ def main(argv=None):
             dt = base["dt"] * limit(ch * dp, base["c0"]) / limit(paper_ch * dp, base["c0"])
         rate = base["rate"] * c1["rate"] / p1["rate"]
         per_second = base["particles"] / (dt * rate)  # wall s per simulated s
-        rows.append((dp, ch, m, dt, rate, t_sim[m] * per_second, max_time * per_second))
-        total_meas += t_sim[m] * per_second
-        total_max += max_time * per_second
-    print("\n| dp [mm] | Ch | shifting | dt [s] | M particle-steps/s | to steady + window [h] | "
+        ts = t_sim.get(f"{m}@{dp * 1e3:g}", t_sim[m])
+        to_steady = base["startup"] + ts * per_second
+        to_max = base["startup"] + max_time * per_second
+        rows.append((dp, ch, m, dt, rate, ts, to_steady, to_max))
+        total_meas += to_steady
+        total_max += to_max
+    print("\n| dp [mm] | Ch | shifting | dt [s] | M particle-steps/s | T_sim [s] | to steady + window [h] | "
           f"to max_time {max_time:g} s [h] |")
-    print("|---|---|---|---|---|---|---|")
-    for dp, ch, m, dt, rate, c, cm in rows:
-        print(f"| {dp * 1e3:g} | {ch:g} | {m} | {dt:.3g} | {rate / 1e6:.2f} | {c / 3600:.2f} | {cm / 3600:.1f} |")
-    print(f"| total | | | | | {total_meas / 3600:.1f} | {total_max / 3600:.1f} |")
+    print("|---|---|---|---|---|---|---|---|")
+    for dp, ch, m, dt, rate, ts, c, cm in rows:
+        print(f"| {dp * 1e3:g} | {ch:g} | {m} | {dt:.3g} | {rate / 1e6:.2f} | {ts:g} | {c / 3600:.2f} | "
+              f"{cm / 3600:.1f} |")
+    print(f"| total | | | | | | {total_meas / 3600:.1f} | {total_max / 3600:.1f} |")
 
 
 if __name__ == "__main__":
