@@ -93,7 +93,7 @@ def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
     if out.finest <= target:
         out.dp_needed = float(dp[i1])
     elif r.order < MIN_ORDER:
-        pass
+        pass  # not projected: dp_needed stays NaN
     elif out.extrapolated >= target:
         out.dp_needed = math.inf
     else:
