@@ -1,25 +1,28 @@
 """Projected wall time of config/paper.yaml on this machine, from measured short runs.
 
-Measures, on --threads threads, short runs (--time s of simulated time each, after a compile
-run) of the paper case (examples/conveyor.yaml with the paper grid's settings):
-  - every Ch of the grid with each method at dp = 1 mm (the step rate per Ch and method),
-  - Ch = 1.8 at dp = 0.5 mm and 0.25 mm with each method (how the rate and dt scale).
-Each gives particles N, steps, mean dt, particle-steps/s of the time stepping (the run's own
-wall time) and the start-up (the rest: building the scene and the start's periodic film). A
-case of the grid then costs
-  wall = start-up(dp, method) + T_sim / dt(dp, Ch) * N(dp) / rate(dp, Ch, method)
-with dt and N measured at (dp, Ch = 1.8) and scaled to other Ch by the dp = 1 mm runs
-(dt and rate ratios between Ch at dp = 1 mm), and T_sim the simulated time a case needs:
-its steady time plus averaging window (--t-sim: METHOD=T for every dp, METHOD@DP_MM=T for
-one dp; measured with benchmarks/time_to_solution.py or a front run) and, as the upper
-bound, the grid's max_time.
+Measures, on --threads threads, a short run of every case of the paper grid (--time s of
+simulated time at dp = 1 and 0.5 mm, --fine-time s at 0.25 mm, after a compile run): the
+paper case (examples/conveyor.yaml with the paper grid's settings) at each (dp, Ch, method)
+of config/paper.yaml. Each gives particles N, steps, mean dt, the viscous update the run took
+(``viscous_update: auto`` picks one per case), particle-steps/s of the time stepping (the
+run's own wall time) and the start-up (the rest: building the scene and the start's periodic
+film). A case then costs
 
-With --set KEY=VALUE (case keys, e.g. viscous_update=implicit cfl=0.4) every run takes
-those settings; with viscous_update=implicit the dt scaling drops the viscous limit.
+  wall = start-up + T_sim / dt * N / rate
+
+with T_sim the simulated time a case needs: its steady time plus averaging window (--t-sim:
+METHOD=T for every dp, METHOD@DP_MM=T for one dp; measured with
+benchmarks/time_to_solution.py or a front run) and, as the upper bound, the grid's max_time.
+With --coarse-only, only dp = 1 mm is measured at every Ch and the finer dp at Ch = 1.8; the
+other cases are scaled from those by the ratio of the binding limit min(C h / c0, C_nu h^2 / nu)
+(h / c0 alone with the implicit update) and the Ch ratio of the rate at dp = 1 mm.
+
+With --set KEY=VALUE (case keys, e.g. viscous_update=auto cfl=0.4) every run takes those
+settings.
 
 Usage: python benchmarks/paper_grid.py [--threads 2] [--time 0.05] [--fine-time 0.02]
            [--t-sim skillen=7.8 lind=12.4] [--set KEY=VALUE ...] [--shifting skillen lind]
-           [--out results/paper_grid] [--reuse]
+           [--coarse-only] [--out results/paper_grid] [--reuse]
 Prints the measured runs and the projection as Markdown.
 """
 from __future__ import annotations
@@ -54,7 +57,8 @@ def measure(dp: float, ch: float, method: str, sim_time: float, settings: dict |
     return {"dp": dp, "ch": ch, "shifting": method, "particles": n, "steps": steps,
             "simulated": float(ds.attrs["simulated_time_s"]), "wall": wall,
             "startup": wall - stepping, "dt": float(ds.attrs["simulated_time_s"]) / steps,
-            "rate": n * steps / stepping, "c0": float(ds.attrs["c0"])}
+            "rate": n * steps / stepping, "c0": float(ds.attrs["c0"]),
+            "update": ds.attrs.get("viscous_update", "explicit")}
 
 
 def main(argv=None):
@@ -66,6 +70,8 @@ def main(argv=None):
     ap.add_argument("--out", default=str(ROOT / "results" / "paper_grid"))
     ap.add_argument("--reuse", action="store_true", help="project from OUT/runs.json, measure nothing")
     ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="case settings of every run")
+    ap.add_argument("--coarse-only", action="store_true",
+                    help="measure every Ch at dp = 1 mm only, and scale the finer dp from Ch = 1.8")
     ap.add_argument("--shifting", nargs="+", default=["skillen", "lind"],
                     help="methods to measure and project (the grid's cases of the others are left out)")
     a = ap.parse_args(argv)
@@ -78,6 +84,9 @@ def main(argv=None):
     paper_ch = grid["grid"].get("paper_ch", 1.8)
     max_time = grid["case"]["steady"]["max_time"]
     t_sim = {k: float(v) for k, v in (s.split("=") for s in a.t_sim)}  # "skillen" or "skillen@0.5"
+    # cases of the paper grid: every Ch with skillen, lind at paper_ch
+    cases = [(dp, ch, "skillen") for dp in grid["grid"]["dp"] for ch in chs if "skillen" in a.shifting]
+    cases += [(dp, paper_ch, "lind") for dp in grid["grid"]["dp"] if "lind" in a.shifting]
     if a.reuse:
         runs = json.loads((out / "runs.json").read_text())
     else:
@@ -87,44 +96,46 @@ def main(argv=None):
         for method in a.shifting:
             for ch in (chs if method == "skillen" else [paper_ch]):  # the grid runs lind at paper_ch
                 runs.append(measure(0.001, ch, method, a.time, settings))
-            runs.append(measure(0.0005, paper_ch, method, a.time, settings))
-            runs.append(measure(0.00025, paper_ch, method, a.fine_time, settings))
+            if a.coarse_only:
+                runs.append(measure(0.0005, paper_ch, method, a.time, settings))
+                runs.append(measure(0.00025, paper_ch, method, a.fine_time, settings))
+        if not a.coarse_only:
+            runs += [measure(dp, ch, m, a.fine_time if dp < 0.0004 else a.time, settings)
+                     for dp, ch, m in cases if dp != 0.001]
         (out / "runs.json").write_text(json.dumps(runs, indent=1))
-    print("| dp [mm] | Ch | shifting | particles | simulated [s] | steps | dt [s] | wall [s] | start-up [s] | "
-          "M particle-steps/s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| dp [mm] | Ch | shifting | viscous update | particles | simulated [s] | steps | dt [s] | wall [s] | "
+          "start-up [s] | M particle-steps/s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in runs:
-        print(f"| {r['dp'] * 1e3:g} | {r['ch']:g} | {r['shifting']} | {r['particles']} | {r['simulated']:.3f} | "
-              f"{r['steps']} | {r['dt']:.3g} | {r['wall']:.1f} | {r['startup']:.1f} | {r['rate'] / 1e6:.2f} |")
+        print(f"| {r['dp'] * 1e3:g} | {r['ch']:g} | {r['shifting']} | {r.get('update', 'explicit')} | "
+              f"{r['particles']} | {r['simulated']:.3f} | {r['steps']} | {r['dt']:.3g} | {r['wall']:.1f} | "
+              f"{r['startup']:.1f} | {r['rate'] / 1e6:.2f} |")
 
     def run_of(dp, ch, m):
-        return next(r for r in runs if r["dp"] == dp and r["ch"] == ch and r["shifting"] == m)
+        return next((r for r in runs if r["dp"] == dp and r["ch"] == ch and r["shifting"] == m), None)
 
-    # cases of the paper grid: every Ch with skillen, lind at paper_ch
-    cases = [(dp, ch, "skillen") for dp in grid["grid"]["dp"] for ch in chs if "skillen" in a.shifting]
-    cases += [(dp, paper_ch, "lind") for dp in grid["grid"]["dp"] if "lind" in a.shifting]
     nu = grid["case"]["viscosity"] / grid["case"]["density"]
-
-    implicit = settings.get("viscous_update") == "implicit"
     cfl = float(settings.get("cfl", grid["case"].get("cfl", 0.2)))
     cfl_nu = float(settings.get("cfl_viscous") or cfl)
 
-    def limit(h, c0):
+    def limit(h, c0, implicit):
         """The step the solver takes at smoothing length h: min(C h / c0, C_nu h^2 / nu)."""
         return cfl * h / c0 if implicit else min(cfl * h / c0, cfl_nu * h * h / nu)
 
     total_meas = total_max = 0.0
     rows = []
     for dp, ch, m in cases:
-        base = run_of(dp, paper_ch, m)
-        c1, p1 = run_of(0.001, ch, m), run_of(0.001, paper_ch, m)
-        # dt at (dp, Ch): measured at dp = 1 mm; at finer dp the measured dt at paper_ch times
-        # the ratio of the binding limit, min(h / c0, h^2 / nu), between Ch and paper_ch
-        if dp == 0.001:
-            dt = c1["dt"]
+        own = run_of(dp, ch, m)
+        if own is not None:  # measured
+            base, dt, rate = own, own["dt"], own["rate"]
         else:
-            dt = base["dt"] * limit(ch * dp, base["c0"]) / limit(paper_ch * dp, base["c0"])
-        rate = base["rate"] * c1["rate"] / p1["rate"]
+            # scaled from (dp, paper_ch) by the ratio of the binding limit between Ch and
+            # paper_ch, and the rate by its Ch ratio at dp = 1 mm
+            base = run_of(dp, paper_ch, m)
+            c1, p1 = run_of(0.001, ch, m), run_of(0.001, paper_ch, m)
+            imp = base.get("update") == "implicit"
+            dt = base["dt"] * limit(ch * dp, base["c0"], imp) / limit(paper_ch * dp, base["c0"], imp)
+            rate = base["rate"] * c1["rate"] / p1["rate"]
         per_second = base["particles"] / (dt * rate)  # wall s per simulated s
         ts = t_sim.get(f"{m}@{dp * 1e3:g}", t_sim[m])
         to_steady = base["startup"] + ts * per_second

@@ -70,6 +70,7 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         "threads": res.threads,
         "n_particles": res.n_particles,
         "dp": sc.dp, "h": sc.h, "c0": sc.c0, "rho0": sc.fluid.density,
+        "viscous_update": "implicit" if sc.implicit_viscosity else "explicit",
         "scene_yaml": sc.to_yaml(),
     }
     attrs.update({f"version_{k}": v for k, v in versions().items()})

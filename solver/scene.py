@@ -17,7 +17,10 @@ SHIFTING_METHODS = ("none", "skillen", "lind")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
-VISCOUS_UPDATES = ("explicit", "implicit")
+VISCOUS_UPDATES = ("explicit", "implicit", "auto")
+# auto: implicit where the explicit viscous step is at least this many times below the acoustic
+# one (an implicit step costs 2.6-3.2 explicit ones on the paper case at dp = 0.25 mm)
+AUTO_IMPLICIT_RATIO = 3.0
 LIND_MIN_CH = 1.1  # below it Lind shifting fails on the conveyor case (docs/numerics.md)
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
 
@@ -167,8 +170,9 @@ class Physics:
     # beta: interior density relaxes towards the particles' packing at a rate beta c0 / h
     # (solver/packing.py); null: off
     volume_relaxation: float | None = None
-    # explicit (SPEC: the laminar term at v^n, dt bounded by h^2 / nu) or implicit (backward
-    # Euler in the laminar term, no viscous limit on dt: solver/implicit.py)
+    # explicit (SPEC: the laminar term at v^n, dt bounded by h^2 / nu), implicit (backward
+    # Euler in the laminar term, no viscous limit on dt: solver/implicit.py) or auto (implicit
+    # where it saves steps: Scene.implicit_viscosity)
     viscous_update: str = "explicit"
     # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
     artificial_viscosity: float | None = None
@@ -242,6 +246,17 @@ class Scene(YamlData):
             return self.sound.c0
         g = math.hypot(*self.gravity)
         return self.sound.coefsound * math.sqrt(g * self.sound.depth)
+
+    @property
+    def implicit_viscosity(self) -> bool:
+        """Whether the laminar term is updated implicitly: ``viscous_update: implicit``, or
+        ``auto`` where the explicit viscous step C_nu h^2 / nu is at least AUTO_IMPLICIT_RATIO
+        times below the acoustic one C h / c0 (C_nu = cfl_viscous, or cfl)."""
+        update = self.physics.viscous_update
+        if update != "auto":
+            return update == "implicit"
+        c_nu = self.cfl if self.cfl_viscous is None else self.cfl_viscous
+        return self.cfl * self.h / self.c0 >= AUTO_IMPLICIT_RATIO * c_nu * self.h ** 2 / self.nu
 
     @property
     def shift_density_correction(self) -> bool:
@@ -539,7 +554,7 @@ def validate(scene: Scene) -> None:
         _interval(scene.domain.z, "domain.z")
     n = scene.estimated_particles()
     per_particle = BYTES_PER_PARTICLE
-    if scene.physics.viscous_update == "implicit":
+    if scene.implicit_viscosity:
         from .implicit import bytes_per_particle
         per_particle += bytes_per_particle(scene.ch)
     need = n * per_particle / 1e9

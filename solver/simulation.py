@@ -77,7 +77,7 @@ class Simulation:
         self.strain_correction = self.variable_viscosity and bool(s.fluid.strain_rate_correction)
         # the last strain rate (strain_rate_correction; a placeholder otherwise)
         self.gamma_p = np.zeros(self.n if self.strain_correction else 1)
-        self.implicit = s.physics.viscous_update == "implicit"
+        self.implicit = s.implicit_viscosity
         self.volume_relaxation = s.physics.volume_relaxation or 0.0
         # its concentration's slot (the option needs shifting)
         self.volume_slot = forces.volume_slot(True, self.correct_shift, self.viscous_correction,

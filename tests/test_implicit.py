@@ -101,8 +101,44 @@ def test_a_viscosity_wrong_name_is_refused_with_its_key():
     from solver.scene import SceneError, scene_from_dict
     d = example_scene("couette").to_dict()
     d["physics"]["viscous_update"] = "crank-nicolson"
-    with pytest.raises(SceneError, match=r"physics.viscous_update: 'crank-nicolson' is not one of explicit, implicit"):
+    with pytest.raises(SceneError, match=r"physics.viscous_update: 'crank-nicolson' is not one of explicit, implicit, auto"):
         scene_from_dict(d)
+
+
+@pytest.mark.parametrize("dp, ch, implicit_expected", [
+    (1.0e-3, 1.8, False),   # the viscous step 0.2 h^2/nu is 1.05 times below the acoustic 0.4 h/c0
+    (0.5e-3, 1.0, True),    # 3.8 times below
+    (0.5e-3, 1.3, False),   # 2.9 times below
+    (0.25e-3, 2.2, True),   # 3.4 times below
+])
+def test_auto_takes_the_implicit_update_where_the_viscous_limit_is_three_times_below(dp, ch, implicit_expected):
+    """``viscous_update: auto`` on the fast paper case (cfl 0.4, cfl_viscous 0.2): implicit where
+    cfl h / c0 >= 3 cfl_viscous h^2 / nu; the ratio is computed here from the case's own numbers."""
+    from solver.conveyor import build_scene, case_from_dict
+    from solver.scene import AUTO_IMPLICIT_RATIO, read_yaml
+    from tests.conftest import EXAMPLES
+    d = read_yaml(EXAMPLES / "conveyor_fast.yaml")
+    d.update(dp=dp, ch=ch, viscous_update="auto")
+    sc = build_scene(case_from_dict(d))
+    ratio = (0.4 * sc.h / sc.c0) / (0.2 * sc.h ** 2 / sc.nu)
+    assert (ratio >= AUTO_IMPLICIT_RATIO) == implicit_expected
+    assert sc.implicit_viscosity == implicit_expected
+    d["viscous_update"] = "explicit"
+    assert not build_scene(case_from_dict(d)).implicit_viscosity
+
+
+def test_the_run_records_which_viscous_update_auto_chose():
+    """The Couette channel (nu = 1e-3 m^2/s, tiny dp): its viscous limit is far below the
+    acoustic one, so ``auto`` runs it implicitly, and the output says so."""
+    from solver.output import to_dataset
+    from solver.run import run_scene
+    sc = example_scene("couette", physics={"viscous_update": "auto"}, time={"end": 2e-4, "output_interval": 1e-4})
+    assert sc.implicit_viscosity
+    res = run_scene(sc)
+    assert res.status == "completed" and res.steps > 0
+    assert to_dataset(res).attrs["viscous_update"] == "implicit"
+    sc = example_scene("couette", physics={"viscous_update": "auto"}, cfl_viscous=1e3)
+    assert not sc.implicit_viscosity
 
 
 @pytest.mark.slow
