@@ -58,7 +58,8 @@ def measure(dp: float, ch: float, method: str, sim_time: float, settings: dict |
             "simulated": float(ds.attrs["simulated_time_s"]), "wall": wall,
             "startup": wall - stepping, "dt": float(ds.attrs["simulated_time_s"]) / steps,
             "rate": n * steps / stepping, "c0": float(ds.attrs["c0"]),
-            "update": ds.attrs.get("viscous_update", "explicit")}
+            "update": ds.attrs.get("viscous_update", "explicit"),
+            "cg_per_step": int(ds.attrs.get("cg_iterations", 0)) / max(steps, 1)}
 
 
 def main(argv=None):

@@ -71,6 +71,7 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         "n_particles": res.n_particles,
         "dp": sc.dp, "h": sc.h, "c0": sc.c0, "rho0": sc.fluid.density,
         "viscous_update": "implicit" if sc.implicit_viscosity else "explicit",
+        "cg_iterations": res.cg_iterations,
         "scene_yaml": sc.to_yaml(),
     }
     attrs.update({f"version_{k}": v for k, v in versions().items()})

@@ -27,6 +27,7 @@ class RunResult:
     wall_time: float = 0.0
     threads: int = 1
     n_particles: int = 0
+    cg_iterations: int = 0  # of the implicit viscous solves, over the steps this process ran
     diag_time: list = field(default_factory=list)
     diag: dict = field(default_factory=lambda: {k: [] for k in DIAGNOSTICS})
     snap_time: list = field(default_factory=list)
@@ -159,6 +160,7 @@ class Runner:
             self._snapshot()
         progress(sim, force=True)
         res.steps = sim.steps
+        res.cg_iterations = sim.solver_iterations
         res.wall_time += _time.perf_counter() - tic
         return res
 

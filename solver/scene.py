@@ -19,7 +19,8 @@ MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
 VISCOUS_UPDATES = ("explicit", "implicit", "auto")
 # auto: implicit where the explicit viscous step is at least this many times below the acoustic
-# one (an implicit step costs 2.6-3.2 explicit ones on the paper case at dp = 0.25 mm)
+# one (an implicit step costs 2.7-3.5 explicit ones on the paper case at dp = 0.25 mm:
+# docs/numerics.md, "Implicit viscosity")
 AUTO_IMPLICIT_RATIO = 3.0
 LIND_MIN_CH = 1.1  # below it Lind shifting fails on the conveyor case (docs/numerics.md)
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)

@@ -121,14 +121,15 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
     assert changed == {"name", "shifting", "shift_min_speed", "viscous_correction", "start_velocity", "cfl",
-                       "cfl_viscous", "volume_relaxation", "density_diffusion_reference", "steady"}
+                       "cfl_viscous", "viscous_update", "volume_relaxation", "density_diffusion_reference",
+                       "steady"}
     own = ("max_time", "average")  # the fast example averages over 1 s (measured in docs/conveyor.md)
     assert {k: v for k, v in fast_d["steady"].items() if k not in own} == \
         {k: v for k, v in paper_d["steady"].items() if k not in own}
     assert fast_d["steady"]["average"] == 1.0
     fast = case_from_dict(fast_d)
     assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
-    assert (fast.cfl, fast.cfl_viscous) == (0.4, 0.2)
+    assert (fast.cfl, fast.cfl_viscous, fast.viscous_update) == (0.4, 0.2, "auto")
     assert fast.shift_min_speed == 0.5
     assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
     assert fast.h_n == paper().h_n
