@@ -1,6 +1,7 @@
 """Cell-linked list: cells of side >= 2h, particles kept sorted by cell.
 
-Cell id = ix * ncz + iz. Boundary particles whose 3x3 cell neighbourhood holds no fluid
+Cell id = ix * ncz + iz, so the cells of a grid column are consecutive; within each cell the
+particles are sorted by z, so each column is sorted by z. Boundary particles whose 3x3 cell neighbourhood holds no fluid
 go to a sentinel bucket after the last cell: they take part in no pair loop.
 """
 from __future__ import annotations
@@ -140,6 +141,23 @@ def counting_sort(cell, nbuckets, order, start):
         c = cell[i]
         order[fill[c]] = i
         fill[c] += 1
+
+
+@nb.njit(parallel=True, cache=True)
+def sort_cells_by(key, order, start, ncells):
+    """Within each of the first ``ncells`` cells, order its particles by ascending key[i]
+    (insertion sort: the last step's order, which the stable counting sort keeps, is nearly
+    sorted already). With key = z every grid column is then sorted by z."""
+    for c in nb.prange(ncells):
+        lo, hi = start[c], start[c + 1]
+        for i in range(lo + 1, hi):
+            v = order[i]
+            kv = key[v]
+            j = i - 1
+            while j >= lo and key[order[j]] > kv:
+                order[j + 1] = order[j]
+                j -= 1
+            order[j + 1] = v
 
 
 @nb.njit(parallel=True, cache=True)

@@ -275,6 +275,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         eta2 = 0.01 * h * h
         alpha = alpha_2d(h)
         four_h2 = 4.0 * h * h
+        two_h = 2.0 * h
         inv_h = 1.0 / h
         for t in nb.prange(nt):
             at = acc[t]
@@ -286,43 +287,53 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
             npl = 0
             cap = pair_i.shape[1]
             for ix in range(split[t], split[t + 1]):
+                # half stencil: b > a in this column and every b of the next column, each
+                # within 2h of a in z. Columns are sorted by z (``cells.sort_cells_by``) and a
+                # walks its column upwards, so both z windows are ranges whose ends only move up
+                jx = ix + 1
+                next_shift = 0.0
+                has_next = True
+                if jx == ncx:
+                    has_next = periodic
+                    jx = 0
+                    next_shift = period
+                col_end = start[(ix + 1) * ncz]
+                own_hi = start[ix * ncz]
+                nx_lo = nx_hi = nx_end = 0
+                if has_next:
+                    nx_lo = nx_hi = start[jx * ncz]
+                    nx_end = start[(jx + 1) * ncz]
                 for iz in range(ncz):
                     ca = ix * ncz + iz
                     a0, a1 = start[ca], start[ca + 1]
                     if a0 == a1:
                         continue
-                    for s_k in range(5):
-                        # half stencil: self, (0,+1), (+1,-1), (+1,0), (+1,+1)
-                        jx = ix if s_k < 2 else ix + 1
-                        jz = iz + 1 if s_k == 1 else (iz if s_k < 2 else iz + s_k - 3)
-                        shift = 0.0
-                        if jx == ncx:
-                            if not periodic:
-                                continue
-                            jx = 0
-                            shift = period
-                        if jz < 0 or jz >= ncz:
-                            continue
-                        cb = jx * ncz + jz
-                        b0, b1 = start[cb], start[cb + 1]
-                        if b0 == b1:
-                            continue
-                        for a in range(a0, a1):
-                            xa, za, ua, wa = x[a], z[a], u[a], w[a]
-                            ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
-                            Va = ma / ra
-                            cell_a = f.cell[a]
-                            ira = 1.0 / ra
-                            s_ax = s_az = s_drho = 0.0
-                            s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
-                            s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
-                            s_diag = 0.0
-                            s_lapg = s_supp = 0.0
-                            s_volc = 0.0
-                            sxa = sza = 0.0
-                            if shift_correction:
-                                sxa, sza = f.sdx[a], f.sdz[a]
-                            first = a + 1 if s_k == 0 else b0
+                    for a in range(a0, a1):
+                        xa, za, ua, wa = x[a], z[a], u[a], w[a]
+                        ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
+                        Va = ma / ra
+                        cell_a = f.cell[a]
+                        ira = 1.0 / ra
+                        s_ax = s_az = s_drho = 0.0
+                        s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
+                        s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
+                        s_diag = 0.0
+                        s_lapg = s_supp = 0.0
+                        s_volc = 0.0
+                        sxa = sza = 0.0
+                        if shift_correction:
+                            sxa, sza = f.sdx[a], f.sdz[a]
+                        z_lo, z_hi = za - two_h, za + two_h
+                        own_hi = max(own_hi, a + 1)
+                        while own_hi < col_end and z[own_hi] < z_hi:
+                            own_hi += 1
+                        while nx_lo < nx_end and z[nx_lo] <= z_lo:
+                            nx_lo += 1
+                        nx_hi = max(nx_hi, nx_lo)
+                        while nx_hi < nx_end and z[nx_hi] < z_hi:
+                            nx_hi += 1
+                        for side in range(2):
+                            first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
                             for b in range(first, b1):
                                 kb = kind[b]
                                 if ka + kb == 2:
@@ -438,33 +449,33 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
                                     s_divdr += Vb * e
                                     at[b, DIVDR] += Va * e
-                            at[a, AX] += s_ax
-                            at[a, AZ] += s_az
-                            at[a, DRHO] += s_drho
-                            if shifting:
-                                at[a, GCX] += s_gcx
-                                at[a, GCZ] += s_gcz
-                                at[a, DIVR] += s_divr
-                                at[a, WNX] += s_wnx
-                                at[a, WNZ] += s_wnz
-                            if shift_correction:
-                                at[a, DIVDR] += s_divdr
-                            if viscous_correction:
-                                at[a, VGX] += s_vgx
-                                at[a, VGZ] += s_vgz
-                                at[a, VDIVR] += s_vdivr
-                            if volume:
-                                at[a, VOLC] += s_volc
-                            if implicit:
-                                at[a, DIAG] += s_diag
-                            if strain_correction:
-                                at[a, LAPG] += s_lapg
-                                at[a, SUPP] += s_supp
-                            if velocity_gradient:
-                                at[a, DUX] += s_dux
-                                at[a, DUZ] += s_duz
-                                at[a, DWX] += s_dwx
-                                at[a, DWZ] += s_dwz
+                        at[a, AX] += s_ax
+                        at[a, AZ] += s_az
+                        at[a, DRHO] += s_drho
+                        if shifting:
+                            at[a, GCX] += s_gcx
+                            at[a, GCZ] += s_gcz
+                            at[a, DIVR] += s_divr
+                            at[a, WNX] += s_wnx
+                            at[a, WNZ] += s_wnz
+                        if shift_correction:
+                            at[a, DIVDR] += s_divdr
+                        if viscous_correction:
+                            at[a, VGX] += s_vgx
+                            at[a, VGZ] += s_vgz
+                            at[a, VDIVR] += s_vdivr
+                        if volume:
+                            at[a, VOLC] += s_volc
+                        if implicit:
+                            at[a, DIAG] += s_diag
+                        if strain_correction:
+                            at[a, LAPG] += s_lapg
+                            at[a, SUPP] += s_supp
+                        if velocity_gradient:
+                            at[a, DUX] += s_dux
+                            at[a, DUZ] += s_duz
+                            at[a, DWX] += s_dwx
+                            at[a, DWZ] += s_dwz
             vmax[t] = vm
             pair_count[t] = npl
 

@@ -158,6 +158,7 @@ class Simulation:
                     f"z in [{self.domain[2]:.4g}, {self.domain[3]:.4g}] m at "
                     f"({self.x[bad]:.4g}, {self.z[bad]:.4g})")
         cells.counting_sort(self.cell, g.ncells + 1, self.order, self.start)
+        cells.sort_cells_by(self.z, self.order, self.start, g.ncells)  # the pair loop's z windows
         for name in self.sorted_fields:
             arr = getattr(self, name)
             buf = self._buf.setdefault(np.dtype(arr.dtype), np.empty(self.n, arr.dtype))
