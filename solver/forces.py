@@ -177,10 +177,10 @@ def pressure_factor(pa, pb, ira, irb, F, fluid_wall):
 
 
 @nb.njit(inline="always", cache=True)
-def laminar_factor(nu, rdotg, ra, rb, inv_r2e):
+def laminar_factor(nu, rdotg, inv_rsum, inv_r2e):
     """vt = 4 nu (r_ab . gradW_ab) / ((rho_a + rho_b)(r^2 + eta^2)), so that du_a/dt gets
-    m_b vt u_ab (Lo & Shao)."""
-    return 4.0 * nu * rdotg / (ra + rb) * inv_r2e
+    m_b vt u_ab (Lo & Shao); inv_rsum = 1 / (rho_a + rho_b)."""
+    return 4.0 * nu * rdotg * inv_rsum * inv_r2e
 
 
 @nb.njit(inline="always", cache=True)
@@ -195,13 +195,14 @@ def pair_viscosity(nu_a, nu_b, fluid_wall, a_is_fluid):
 
 
 @nb.njit(inline="always", cache=True)
-def artificial_factor(av, vdotr, ra, rb, inv_r2e, F):
+def artificial_factor(av, vdotr, inv_rsum, inv_r2e, F):
     """Monaghan's Pi_ab F, so that du_a/dt gets -m_b Pi_ab F r_ab:
     Pi_ab = -alpha h c0 (u_ab . r_ab) / (rho_ab (r^2 + eta^2)), rho_ab = (rho_a + rho_b) / 2,
-    for approaching pairs (u_ab . r_ab < 0), 0 otherwise; av = alpha h c0."""
+    for approaching pairs (u_ab . r_ab < 0), 0 otherwise; av = alpha h c0,
+    inv_rsum = 1 / (rho_a + rho_b)."""
     if vdotr >= 0.0:
         return 0.0
-    return -2.0 * av * vdotr / (ra + rb) * inv_r2e * F
+    return -2.0 * av * vdotr * inv_rsum * inv_r2e * F
 
 
 @nb.njit(inline="always", cache=True)
@@ -219,10 +220,11 @@ def diffusion_spec(g, drab, dz, rho0, k_hyd):
 
 
 @nb.njit(inline="always", cache=True)
-def diffusion_column(g, drab, dz, ra, rb, rho0, k_col):
+def diffusion_column(g, drab, dz, inv_rsum, rho0, k_col):
     """g ((rho_a - rho_b) - rho^H_ab) with the Tait column's
-    rho^H_ab = k_col (z_a - z_b) (rho0 / rho_m)^5, rho_m = (rho_a + rho_b) / 2; b gets its negative."""
-    rm = 2.0 * rho0 / (ra + rb)
+    rho^H_ab = k_col (z_a - z_b) (rho0 / rho_m)^5, rho_m = (rho_a + rho_b) / 2 = 1 / (2 inv_rsum);
+    b gets its negative."""
+    rm = 2.0 * rho0 * inv_rsum
     rm2 = rm * rm
     return g * (drab - k_col * dz * rm2 * rm2 * rm)
 
@@ -354,6 +356,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 irb = 1.0 / rb
                                 Vb = mb * irb
                                 inv_r2e = 1.0 / (r2 + eta2)
+                                inv_rsum = 1.0 / (ra + rb)
                                 ca, cb = continuity_terms(ra, rb, F, vdotr)
                                 s_drho += ca * Vb
                                 drho_b = cb * Va
@@ -361,11 +364,11 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
                                 if variable_viscosity:
                                     nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
-                                    vt = laminar_factor(nu_ab, rdotg, ra, rb, inv_r2e)
+                                    vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
                                 else:
-                                    vt = laminar_factor(nu, rdotg, ra, rb, inv_r2e)
+                                    vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
                                 if artificial:
-                                    pt += artificial_factor(k.av, vdotr, ra, rb, inv_r2e, F)
+                                    pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
                                 fx = -pt * dx + vt * du
                                 fz = -pt * dz + vt * dw
                                 s_ax += mb * fx
@@ -392,7 +395,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                     if ka + kb == 0:  # fluid pairs only
                                         g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
                                         if column_reference:
-                                            ge = diffusion_column(g, ra - rb, dz, ra, rb, rho0, k.k_col)
+                                            ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
                                             s_drho += ge * Vb
                                             drho_b -= ge * Va
                                         else:
