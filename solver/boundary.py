@@ -19,7 +19,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .cells import cell_of, neighbour_cell
+from .cells import cell_of, column_window, neighbour_cell, neighbour_column
 from .forces import FASTMATH
 from .kernel import alpha_2d, grad_coefficient, grad_factor, kernel, w_value
 
@@ -124,45 +124,47 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
             su = sw = 0.0
             bu1 = bu2 = bw1 = bw2 = 0.0
             for ddx in range(-1, 2):
-                for ddz in range(-1, 2):
-                    c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
-                    if c < 0:
+                jx, shift = neighbour_column(cl, ix, ddx)
+                if jx < 0:
+                    continue
+                j0, j1 = column_window(cl, z, jx, iz, gz - 2.0 * h)
+                for j in range(j0, j1):
+                    if z[j] >= gz + 2.0 * h:
+                        break
+                    if kind[j] != 0:
                         continue
-                    for j in range(cl.start[c], cl.start[c + 1]):
-                        if kind[j] != 0:
-                            continue
-                        dx = gx - (x[j] + shift)  # r_gj
-                        dz = gz - z[j]
-                        r2 = dx * dx + dz * dz
-                        if r2 >= four_h2:
-                            continue
-                        q = math.sqrt(r2) / h
-                        Wv = w_value(q, alpha)
-                        F = grad_factor(q, fac)
-                        V = mass[j] / rho[j]
-                        WV = Wv * V
-                        gxv = F * dx * V
-                        gzv = F * dz * V
-                        # r_j - r_g = -(dx, dz); unknown gradient scaled by h
-                        a00 += WV
-                        a01 -= dx * WV / h
-                        a02 -= dz * WV / h
-                        a10 += gxv * h
-                        a11 -= gxv * dx
-                        a12 -= gxv * dz
-                        a20 += gzv * h
-                        a21 -= gzv * dx
-                        a22 -= gzv * dz
-                        b0 += rho[j] * WV
-                        b1 += rho[j] * gxv * h
-                        b2 += rho[j] * gzv * h
-                        su += u[j] * WV
-                        sw += w[j] * WV
-                        if corrected_velocity:
-                            bu1 += u[j] * gxv * h
-                            bu2 += u[j] * gzv * h
-                            bw1 += w[j] * gxv * h
-                            bw2 += w[j] * gzv * h
+                    dx = gx - (x[j] + shift)  # r_gj
+                    dz = gz - z[j]
+                    r2 = dx * dx + dz * dz
+                    if r2 >= four_h2:
+                        continue
+                    q = math.sqrt(r2) / h
+                    Wv = w_value(q, alpha)
+                    F = grad_factor(q, fac)
+                    V = mass[j] / rho[j]
+                    WV = Wv * V
+                    gxv = F * dx * V
+                    gzv = F * dz * V
+                    # r_j - r_g = -(dx, dz); unknown gradient scaled by h
+                    a00 += WV
+                    a01 -= dx * WV / h
+                    a02 -= dz * WV / h
+                    a10 += gxv * h
+                    a11 -= gxv * dx
+                    a12 -= gxv * dz
+                    a20 += gzv * h
+                    a21 -= gzv * dx
+                    a22 -= gzv * dz
+                    b0 += rho[j] * WV
+                    b1 += rho[j] * gxv * h
+                    b2 += rho[j] * gzv * h
+                    su += u[j] * WV
+                    sw += w[j] * WV
+                    if corrected_velocity:
+                        bu1 += u[j] * gxv * h
+                        bu2 += u[j] * gzv * h
+                        bw1 += w[j] * gxv * h
+                        bw2 += w[j] * gzv * h
             if a00 <= 0.0:
                 rho[i] = floor
                 u[i] = vwx

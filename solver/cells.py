@@ -82,6 +82,39 @@ def neighbour_cell(cl, ix, iz, ddx, ddz):
     return jx * cl.ncz + jz, shift
 
 
+@nb.njit(inline="always", cache=True)
+def neighbour_column(cl, ix, ddx):
+    """(column, x shift to add to its particles) of column ix + ddx, wrapping in x when
+    periodic; column -1 when outside the grid."""
+    jx = ix + ddx
+    if 0 <= jx < cl.ncx:
+        return jx, 0.0
+    if not cl.periodic:
+        return -1, 0.0
+    return (jx + cl.ncx, -cl.period) if jx < 0 else (jx - cl.ncx, cl.period)
+
+
+@nb.njit(inline="always", cache=True)
+def column_window(cl, z, jx, iz, z_lo):
+    """[lo, hi): the particles of column jx's cells iz - 1 .. iz + 1 (those in the grid), lo
+    moved up to the first with z >= z_lo (bisection: a column is sorted by z). A caller
+    walking up from lo stops at its own upper z."""
+    jlo = max(iz - 1, 0)
+    jhi = min(iz + 1, cl.ncz - 1)
+    if jlo > jhi:
+        return 0, 0
+    lo = cl.start[jx * cl.ncz + jlo]
+    hi = cl.start[jx * cl.ncz + jhi + 1]
+    a, b = lo, hi
+    while a < b:
+        m = (a + b) // 2
+        if z[m] < z_lo:
+            a = m + 1
+        else:
+            b = m
+    return a, hi
+
+
 @nb.njit(cache=True)
 def assign_cells(x, z, kind, cl, cell):
     """Write each particle's cell (sentinel ncx*ncz for idle boundary particles).
