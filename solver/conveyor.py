@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import lubrication, viscoplastic
-from .scene import VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into, scene_from_dict
+from .scene import NEAR_SURFACE, VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into, scene_from_dict
 from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication", "warm")
@@ -69,6 +69,9 @@ class ConveyorCase(YamlData):
     # skillen: the shift's speed is max(|u|, shift_min_speed u_b) (0: SPEC's |u|); not used by
     # the other methods, so that one campaign grid holds both
     shift_min_speed: float = 0.0
+    # lind within 2h of the free surface: "none" (SPEC: no shift) or "tangential" (along the
+    # surface only); not used by the other methods, so that one campaign grid holds both
+    shift_near_surface: str = "none"
     density: float = 1383.0
     viscosity: float = 5.6  # mu [Pa s] of a newtonian fluid (not used by herschel_bulkley)
     rheology: str = "newtonian"  # or herschel_bulkley (the scene's fluid keys below)
@@ -171,6 +174,9 @@ def validate_case(c: ConveyorCase) -> None:
     if not (c.shift_min_speed >= 0 and math.isfinite(c.shift_min_speed)):
         raise SceneError(f"case.shift_min_speed: must be a finite number >= 0 (a fraction of the belt "
                          f"speed), got {c.shift_min_speed!r}")
+    if c.shift_near_surface not in NEAR_SURFACE:
+        raise SceneError(f"case.shift_near_surface: {c.shift_near_surface!r} is not one of "
+                         f"{', '.join(NEAR_SURFACE)}")
     if c.newtonian and c.strain_rate_correction:
         raise SceneError("case.strain_rate_correction: only for rheology herschel_bulkley")
     if c.viscous_update not in VISCOUS_UPDATES:
@@ -316,6 +322,8 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
             shifting[key] = value
     if c.shift_min_speed and c.shifting == "skillen":
         shifting["min_speed"] = c.shift_min_speed * c.belt.speed
+    if c.shifting == "lind":
+        shifting["near_surface"] = c.shift_near_surface
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,

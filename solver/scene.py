@@ -14,6 +14,8 @@ import numpy as np
 import yaml
 
 SHIFTING_METHODS = ("none", "skillen", "lind")
+# lind within 2h of the free surface: SPEC's no shift, or the shift along the surface only
+NEAR_SURFACE = ("none", "tangential")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
@@ -155,6 +157,9 @@ class Shifting:
     correction_limit: float | None = None
     # skillen: the speed in dr = -A h |u| dt gradC is max(|u|, min_speed) [m/s] (0: SPEC's |u|)
     min_speed: float = 0.0
+    # lind within 2h of the free surface: "none" (SPEC: no shift) or "tangential" (the part of
+    # the shift along the surface, Lind et al. 2012; docs/numerics.md)
+    near_surface: str = "none"
 
 
 @dataclass
@@ -505,6 +510,12 @@ def validate(scene: Scene) -> None:
     if sh.min_speed > 0 and sh.method != "skillen":
         raise SceneError(f"physics.shifting.min_speed: applies to method skillen only (its shift scales "
                          f"with |u|), got method {sh.method!r}")
+    if sh.near_surface not in NEAR_SURFACE:
+        raise SceneError(f"physics.shifting.near_surface: {sh.near_surface!r} is not one of "
+                         f"{', '.join(NEAR_SURFACE)}")
+    if sh.near_surface != "none" and sh.method != "lind":
+        raise SceneError(f"physics.shifting.near_surface: applies to method lind only (skillen scales its "
+                         f"shift near the surface by div r), got method {sh.method!r}")
     if not 0 < sh.surface_threshold < 2:
         raise SceneError(
             f"physics.shifting.surface_threshold: must lie in (0, 2), got {sh.surface_threshold}")

@@ -10,7 +10,12 @@ skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - th
          floor").
 lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp; no shift for
          particles within 2h of a free-surface particle (div r < thr, or a scan-region test
-         where thr <= div r < 1.9, see free_surface).
+         where thr <= div r < 1.9, see free_surface). With ``near_surface: tangential``
+         (Lind et al. 2012) those particles shift too, by the part of gradC along the surface
+         only: dr = -D (gradC - (gradC.n) n), n the weighted mean of the outward normals
+         -gradC/|gradC| of the free-surface particles within 2h (``surface_normals``), except
+         the free-surface particles within 2h of a wall (where the surface meets a wall: no
+         shift, as SPEC).
 Density correction (default on): shifting moves particles relative to the fluid, so each
 particle's volume changes by V div(dr); with its mass fixed its density becomes
 rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab, summed in the next
@@ -169,6 +174,71 @@ def near_surface(x, z, kind, surface, cl, n_active, h, near):
                     ez = z[i] - z[j]
                     if ex * ex + ez * ez < four_h2:
                         near[i] = 1
+
+
+@nb.njit(cache=True)
+def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, nx, nz):
+    """(nx, nz)[i] = the unit vector along sum_j (1 - q_ij/2)^4 n_j over the free-surface
+    particles j within 2h of fluid particle i (i itself included), n_j = -gradC_j / |gradC_j|
+    their outward normals; zero where there is none. Scattered from the surface particles,
+    which are few: serial."""
+    four_h2 = 4.0 * h * h
+    for i in range(n_active):
+        nx[i] = 0.0
+        nz[i] = 0.0
+    for j in range(n_active):
+        if not surface[j]:
+            continue
+        g = math.sqrt(gcx[j] * gcx[j] + gcz[j] * gcz[j])
+        if g == 0.0:
+            continue
+        ox, oz = -gcx[j] / g, -gcz[j] / g
+        ix, iz = cell_of(cl, x[j], z[j])
+        for ddx in range(-1, 2):
+            for ddz in range(-1, 2):
+                c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
+                if c < 0:
+                    continue
+                for i in range(cl.start[c], cl.start[c + 1]):
+                    if kind[i] != 0:
+                        continue
+                    ex = x[i] + shift - x[j]
+                    ez = z[i] - z[j]
+                    r2 = ex * ex + ez * ez
+                    if r2 < four_h2:
+                        s = 1.0 - 0.5 * math.sqrt(r2) / h
+                        wgt = s * s * s * s
+                        nx[i] += wgt * ox
+                        nz[i] += wgt * oz
+    for i in range(n_active):
+        nn = math.sqrt(nx[i] * nx[i] + nz[i] * nz[i])
+        if nn > 0.0:
+            nx[i] /= nn
+            nz[i] /= nn
+
+
+@nb.njit(parallel=True, cache=True)
+def lind_shift_tangential(kind, gcx, gcz, near, surface, snx, snz, wnx, wnz, s0, n_active, D, clip, dx_out,
+                          dz_out):
+    """dr = -D gradC, each component clipped, never into a wall; within 2h of the free surface
+    (``near``) only its part along the surface, -D (gradC - (gradC.n) n), n = (snx, snz)
+    (``surface_normals``); no shift where n is zero, nor for a free-surface particle (``surface``)
+    with a wall particle within 2h (where the surface meets a wall, as SPEC's lind)."""
+    for i in nb.prange(n_active):
+        dx_out[i] = 0.0
+        dz_out[i] = 0.0
+        if kind[i] != 0:
+            continue
+        gx, gz = gcx[i], gcz[i]
+        if near[i]:
+            nx, nz = snx[i], snz[i]
+            if (nx == 0.0 and nz == 0.0) or (surface[i] and (wnx[i] != 0.0 or wnz[i] != 0.0)):
+                continue
+            d = gx * nx + gz * nz
+            gx -= d * nx
+            gz -= d * nz
+        dx_out[i], dz_out[i] = _off_wall(min(max(-D * gx, -clip), clip),
+                                         min(max(-D * gz, -clip), clip), wnx[i], wnz[i], s0)
 
 
 @nb.njit(parallel=True, cache=True)

@@ -134,6 +134,9 @@ class Simulation:
         self.shift_dz = np.zeros(self.n)
         self.surface_flag = np.zeros(self.n, dtype=np.int8)
         self.near_flag = np.zeros(self.n, dtype=np.int8)
+        tangential = s.physics.shifting.near_surface == "tangential"
+        self.surface_nx = np.zeros(self.n if tangential else 1)  # lind's surface normals
+        self.surface_nz = np.zeros(self.n if tangential else 1)
         self.wall_s0 = shifting.wall_proximity_at_half_dp(self.h, s.dp)
         self._buf = {np.dtype(a.dtype): np.empty(self.n, a.dtype)
                      for a in (self.x, self.kind, self.wall, self.pid)}
@@ -270,9 +273,16 @@ class Simulation:
                                   self.surface_flag)
             shifting.near_surface(self.x, self.z, self.kind, self.surface_flag, self.cells,
                                   self.n_active, self.h, self.near_flag)
-            shifting.lind_shift(self.kind, gcx, gcz, self.near_flag, wnx, wnz, self.wall_s0,
-                                self.n_active, 0.5 * A * self.h * self.h, clip,
-                                self.shift_dx, self.shift_dz)
+            D = 0.5 * A * self.h * self.h
+            if sh.near_surface == "tangential":
+                shifting.surface_normals(self.x, self.z, self.kind, self.surface_flag, gcx, gcz, self.cells,
+                                         self.n_active, self.h, self.surface_nx, self.surface_nz)
+                shifting.lind_shift_tangential(self.kind, gcx, gcz, self.near_flag, self.surface_flag, self.surface_nx,
+                                               self.surface_nz, wnx, wnz, self.wall_s0, self.n_active, D, clip,
+                                               self.shift_dx, self.shift_dz)
+            else:
+                shifting.lind_shift(self.kind, gcx, gcz, self.near_flag, wnx, wnz, self.wall_s0,
+                                    self.n_active, D, clip, self.shift_dx, self.shift_dz)
         # the density follows the volume change of the shift at the next evaluation
         self.x[:self.n_active] += self.shift_dx[:self.n_active]
         self.z[:self.n_active] += self.shift_dz[:self.n_active]

@@ -114,13 +114,15 @@ def test_start_falls_back_to_h_n_when_the_film_stops():
 def test_fast_example_is_the_paper_case_with_its_documented_settings():
     """examples/conveyor_fast.yaml differs from conveyor.yaml only in the settings that
     docs/conveyor.md measures ("A steady answer in two minutes"; its 1 s average: "Every span, a 1 s
-    average"), and builds a valid scene."""
+    average"; lind's tangential shift near the surface: docs/numerics.md, "Lind near the free
+    surface"), and builds a valid scene."""
     with open(EXAMPLES / "conveyor.yaml") as fh:
         paper_d = yaml.safe_load(fh)
     with open(EXAMPLES / "conveyor_fast.yaml") as fh:
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
-    assert changed == {"name", "shifting", "shift_min_speed", "viscous_correction", "start_velocity", "cfl",
+    assert changed == {"name", "shifting", "shift_min_speed", "shift_near_surface", "viscous_correction",
+                       "start_velocity", "cfl",
                        "cfl_viscous", "viscous_update", "volume_relaxation", "density_diffusion_reference",
                        "steady"}
     own = ("max_time", "average")  # the fast example averages over 1 s (measured in docs/conveyor.md)
@@ -131,6 +133,7 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
     assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
     assert (fast.cfl, fast.cfl_viscous, fast.viscous_update) == (0.4, 0.2, "auto")
     assert fast.shift_min_speed == 0.5
+    assert fast.shift_near_surface == "tangential"  # lind's, when the example runs with shifting=lind
     assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
     assert fast.h_n == paper().h_n
     build_scene(replace(fast, dp=4.0e-3, ch=1.5))
@@ -158,6 +161,19 @@ def test_shift_min_speed_is_a_fraction_of_the_belt_speed_for_skillen_only():
     assert skillen.physics.shifting.min_speed == pytest.approx(0.5 * 0.075)
     lind = build_scene(paper(shifting="lind", shift_min_speed=0.5, dp=4.0e-3))
     assert lind.physics.shifting.min_speed == 0.0
+
+
+def test_shift_near_surface_reaches_lind_only_and_is_checked():
+    """The tangential near-surface shift is lind's (skillen scales its shift near the surface by
+    div r): passed to lind's scene, not to skillen's, so one grid holds both; a wrong value is
+    refused naming the key and the allowed values."""
+    lind = build_scene(paper(shifting="lind", shift_near_surface="tangential", dp=4.0e-3))
+    assert lind.physics.shifting.near_surface == "tangential"
+    skillen = build_scene(paper(shifting="skillen", shift_near_surface="tangential", dp=4.0e-3))
+    assert skillen.physics.shifting.near_surface == "none"
+    assert build_scene(paper(shifting="lind", dp=4.0e-3)).physics.shifting.near_surface == "none"
+    with pytest.raises(SceneError, match="case.shift_near_surface: 'normal' is not one of none, tangential"):
+        build_scene(paper(shifting="skillen", shift_near_surface="normal", dp=4.0e-3))
 
 
 @pytest.mark.slow

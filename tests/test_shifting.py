@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from solver.build import build_particles
+from solver.forces import WNX, WNZ
 from solver.run import run_scene
 from solver.simulation import Simulation
 from tests.conftest import example_scene
@@ -167,10 +168,11 @@ def test_density_correction_follows_the_volume_change_of_the_shift():
     np.testing.assert_allclose(d, eps, rtol=0.01)  # d(dz)/dz = eps
 
 
-def film_inflation(method, correction, t_end=0.5):
+def film_inflation(method, correction, t_end=0.5, near_surface="none"):
     """Relative growth of the film's free-surface height over t_end (periodic film)."""
     from solver.probes import FieldSampler
-    scene = example_scene("film", physics={"shifting": {"method": method, "density_correction": correction}},
+    scene = example_scene("film", physics={"shifting": {"method": method, "density_correction": correction,
+                                                        "near_surface": near_surface}},
                           time={"end": t_end, "output_interval": t_end})
     sim = Simulation(scene)
     xs = np.linspace(0.002, 0.017, 8)
@@ -217,3 +219,66 @@ def test_lind_density_correction_is_limited_per_step():
 def test_lind_with_its_density_correction_does_not_inflate_a_film():
     """The film stays within 0.5 % (skillen's tolerance above) with lind's default correction."""
     assert abs(film_inflation("lind", None)) < 0.005
+
+
+def test_lind_with_the_tangential_near_surface_shift_does_not_inflate_a_film():
+    """Shifting the particles near the surface along it keeps the film within the same 0.5 %."""
+    assert abs(film_inflation("lind", None, near_surface="tangential")) < 0.005
+
+
+def shifted_thin_film(depth_dp, near_surface):
+    """One lind shift of a disordered film depth_dp particles deep (h = 1.5 dp): the shift and
+    the flags, in the simulation's order, of its active particles."""
+    dp = example_scene("film").dp
+    scene = example_scene("film", fluid={"blocks": [{"x": [0.0, 20 * dp], "z": [0.0, depth_dp * dp]}]},
+                          physics={"shifting": {"method": "lind", "density_correction": False,
+                                                "near_surface": near_surface}})
+    parts = build_particles(scene)
+    f = parts.kind == 0
+    rng = np.random.default_rng(3)
+    parts.x[f] += rng.uniform(-0.1, 0.1, f.sum()) * dp
+    parts.z[f] += rng.uniform(-0.1, 0.1, f.sum()) * dp
+    sim = Simulation(scene, parts)
+    sim.shift_only(1e-4)
+    n = sim.n_active
+    fluid = sim.kind[:n] == 0
+    return {"sim": sim, "dp": dp, "dx": sim.shift_dx[:n], "dz": sim.shift_dz[:n],
+            "near": (sim.near_flag[:n] == 1) & fluid, "surface": (sim.surface_flag[:n] == 1) & fluid,
+            "walled": np.hypot(sim.out[WNX, :n], sim.out[WNZ, :n]) > 0}
+
+
+@pytest.mark.parametrize("near_surface", ["none", "tangential"])
+def test_lind_near_the_free_surface(near_surface):
+    """Within 2h of the free surface of a disordered film 4 dp deep, SPEC's lind does not shift;
+    with ``near_surface: tangential`` the particles there move, and only along the surface: the
+    shift has no component along the normal n of the nearby surface particles (dr . n = 0 to
+    round-off wherever neither the clip nor a wall altered it)."""
+    r = shifted_thin_film(4, near_surface)
+    near, dx, dz, dp = r["near"], r["dx"], r["dz"], r["dp"]
+    moved = np.hypot(dx, dz) > 1e-3 * dp
+    assert near.sum() > 30  # the rows within 2h of the surface
+    if near_surface == "none":
+        assert not (moved & near).any()
+        return
+    assert (moved & near).sum() > 0.5 * near.sum(), "the near-surface particles do move"
+    clip = 0.1 * dp * (1 - 1e-9)
+    free = near & ~r["walled"] & (np.abs(dx) < clip) & (np.abs(dz) < clip)
+    assert free.sum() > 10
+    sim = r["sim"]
+    n = sim.n_active
+    along_normal = dx * sim.surface_nx[:n] + dz * sim.surface_nz[:n]
+    assert np.abs(along_normal[free]).max() < 1e-12 * dp
+
+
+def test_lind_tangential_leaves_the_surface_at_a_wall_alone():
+    """Where the free surface meets a wall (a surface particle with a wall particle within 2h),
+    the tangential shift does not move it, as SPEC's lind; the particles under it, within 2h of
+    the surface and of the wall, still shift along the surface. Film 2 dp deep: every particle
+    is within 2h of the bed."""
+    r = shifted_thin_film(2, "tangential")
+    moved = np.hypot(r["dx"], r["dz"]) > 1e-3 * r["dp"]
+    at_wall = r["surface"] & r["walled"]
+    under = r["near"] & r["walled"] & ~r["surface"]
+    assert at_wall.sum() > 10 and under.sum() > 10
+    assert not (moved & at_wall).any()
+    assert (moved & under).sum() > 0.5 * under.sum()
