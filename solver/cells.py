@@ -1,8 +1,10 @@
 """Cell-linked list: cells of side >= 2h, particles kept sorted by cell.
 
 Cell id = ix * ncz + iz, so the cells of a grid column are consecutive; within each cell the
-particles are sorted by z, so each column is sorted by z. Boundary particles whose 3x3 cell neighbourhood holds no fluid
-go to a sentinel bucket after the last cell: they take part in no pair loop.
+particles are sorted by z, so each column is sorted by z and a neighbour search can take a
+z window of a column as one range (the pair loop, the mDBC update). Boundary particles whose
+3x3 cell neighbourhood holds no fluid go to a sentinel bucket after the last cell: they take
+part in no pair loop.
 """
 from __future__ import annotations
 

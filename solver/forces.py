@@ -5,9 +5,11 @@ Fluid-wall pairs never attract: their P_a + P_b is floored at zero. A fluid in s
 to a wall (negative gauge pressure, as in the corner of a belt running into a fixed wall)
 would otherwise be drawn through the wall by the symmetric pressure term.
 
-Each pair (a, b) is visited once and its contributions are added to both particles,
-into per-thread accumulators ``acc[t, i, q]`` (no write races; the slots of one particle
-share a cache line), reduced afterwards; a's sums stay in registers over the b loop.
+Each pair (a, b) is visited once (b after a in a's grid column, or in the next column, and
+within 2h of a in z: two ranges of the z-sorted columns, ``cells``) and its contributions are
+added to both particles, into per-thread accumulators ``acc[t, i, q]`` (no write races; the
+slots of one particle share a cache line), reduced afterwards; a's sums stay in registers
+over the b loop.
 Slots q (named below): ax, az, drho/dt; with shifting gradC_x, gradC_z, div r and the
 kernel-weighted sum of the inward normals of nearby wall particles (where shifting must not
 push); with the shifting density correction, div(dr) of the previous step's shift.

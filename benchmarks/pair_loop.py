@@ -1,0 +1,97 @@
+"""The pair loop alone, of two solver trees, on the same particle arrays: ms per call.
+
+OLD_TREE's solver/ is copied to a temporary package and imported beside this tree's. One
+simulation of this tree (benchmarks/throughput.py's periodic layer, 40k particles) is
+stepped --warmup times; then the two trees' pair loops, compiled with the same options,
+are called on its arrays in turn, --calls times each, the order swapped every call. Both
+read the same memory, so the host's state and the arrays' placement weigh on both alike
+(whole steps of two simulations in one process do not: the one built first runs faster).
+The first call's summed accumulators of the two are compared (round-off only). One JSON
+line per configuration.
+
+Usage: python benchmarks/pair_loop.py OLD_TREE [--ch 1.5 1.8] [--shifting none skillen lind]
+           [--threads 2] [--calls 60]
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from throughput import layer_scene  # noqa: E402
+
+
+def import_tree(tree: Path, name: str):
+    """The solver package of ``tree``, importable as ``name``."""
+    tmp = Path(tempfile.mkdtemp(prefix="sph-surge-old-"))
+    shutil.copytree(tree / "solver", tmp / name, ignore=shutil.ignore_patterns("__pycache__"))
+    sys.path.insert(0, str(tmp))
+    return importlib.import_module(name)
+
+
+def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, particles: int) -> dict:
+    from solver import forces
+    from solver.scene import scene_from_dict
+    from solver.simulation import Simulation
+    s = Simulation(scene_from_dict(layer_scene(ch, shifting, particles)))
+    for _ in range(warmup):
+        s.step()
+    options = dict(diffusion=s.diffusion, shifting=s.shift_method != "none", shift_correction=s.correct_shift,
+                   column_reference=s.scene.physics.density_diffusion_reference == "column")
+    fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
+                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume)
+    loops = [(old_forces.make_pair_loop(**options), old_forces.PairFields(*fields)),
+             (forces.make_pair_loop(**options), fields)]
+
+    def call(k):
+        fn, f = loops[k]
+        tic = time.perf_counter()
+        fn(f, s.cells, s.split, s.constants, s.acc, s.vmax_t, *s.pairs)
+        return time.perf_counter() - tic
+
+    sums = []
+    for k in (0, 1):
+        call(k)
+        sums.append(s.acc.sum(axis=0))
+    times = [[], []]
+    for c in range(calls):
+        for k in ((0, 1) if c % 2 == 0 else (1, 0)):
+            times[k].append(call(k))
+    old, new = (1e3 * np.asarray(t) for t in times)
+    scale = np.abs(sums[0]).max(axis=0)
+    return {"ch": ch, "shifting": shifting, "threads": numba.get_num_threads(), "particles": s.n,
+            "calls": calls, "old_ms": round(float(np.median(old)), 3), "new_ms": round(float(np.median(new)), 3),
+            "new_over_old": round(float(np.median(new) / np.median(old)), 3),
+            "max_rel_difference": float((np.abs(sums[1] - sums[0]).max(axis=0) / np.where(scale > 0, scale, 1)).max())}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("old", type=Path)
+    ap.add_argument("--ch", type=float, nargs="+", default=[1.5, 1.8])
+    ap.add_argument("--shifting", nargs="+", default=["none", "skillen", "lind"])
+    ap.add_argument("--particles", type=int, default=40000)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--calls", type=int, default=60)
+    ap.add_argument("--warmup", type=int, default=20)
+    a = ap.parse_args(argv)
+    numba.set_num_threads(a.threads)
+    old_forces = importlib.import_module(f"{import_tree(a.old.resolve(), 'solver_old').__name__}.forces")
+    for ch in a.ch:
+        for shifting in a.shifting:
+            print(json.dumps(measure(old_forces, ch, shifting, a.calls, a.warmup, a.particles)), flush=True)
+
+
+if __name__ == "__main__":
+    main()
