@@ -21,11 +21,12 @@ With --set KEY=VALUE (case keys, e.g. viscous_update=auto cfl=0.4) every run tak
 settings.
 
 The default T_sim are the measured ones of config/paper.yaml's scheme (benchmarks/RESULTS.md):
-skillen 4.04 s at dp = 1 mm and 2.50 s at 0.5 mm, lind 6.28 s and 3.40 s; dp = 0.25 mm takes
-dp = 1 mm's unless given (METHOD@0.25=T).
+skillen 4.50 s at dp = 1 mm (4.04-4.50 s measured) and 2.50 s at 0.5 mm; lind 3.50 s at 1 mm
+(with its tangential shift near the surface) and 3.40 s at 0.5 mm (measured without it);
+dp = 0.25 mm takes dp = 1 mm's unless given (METHOD@0.25=T).
 
 Usage: python benchmarks/paper_grid.py [--threads 2] [--time 0.05] [--fine-time 0.02]
-           [--t-sim skillen=4.04 skillen@0.5=2.5 lind=6.28 lind@0.5=3.4] [--set KEY=VALUE ...]
+           [--t-sim skillen=4.5 skillen@0.5=2.5 lind=3.5 lind@0.5=3.4] [--set KEY=VALUE ...]
            [--shifting skillen lind]
            [--coarse-only] [--out results/paper_grid] [--reuse]
 Prints the measured runs and the projection as Markdown.
@@ -72,7 +73,7 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--time", type=float, default=0.05)
     ap.add_argument("--fine-time", type=float, default=0.02, help="simulated time at 0.25 mm")
-    ap.add_argument("--t-sim", nargs="+", default=["skillen=4.04", "skillen@0.5=2.5", "lind=6.28", "lind@0.5=3.4"])
+    ap.add_argument("--t-sim", nargs="+", default=["skillen=4.5", "skillen@0.5=2.5", "lind=3.5", "lind@0.5=3.4"])
     ap.add_argument("--out", default=str(ROOT / "results" / "paper_grid"))
     ap.add_argument("--reuse", action="store_true", help="project from OUT/runs.json, measure nothing")
     ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="case settings of every run")
