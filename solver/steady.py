@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 Z = 2.0  # detection: confidence multiplier on the slope's standard error
@@ -53,27 +54,70 @@ def trend(t: np.ndarray, y: np.ndarray) -> float:
 def trend_bound(t, y) -> tuple[float, float]:
     """(slope, standard error of the slope) of the least-squares line, the error widened
     for lag-1 correlation of the residuals; NaNs if fewer than 3 finite samples."""
-    t = np.asarray(t, dtype=float)
-    y = np.asarray(y, dtype=float)
-    ok = np.isfinite(y)
-    n = int(ok.sum())
-    if n < 3:
-        return math.nan, math.nan
-    t, y = t[ok], y[ok]
-    tc = t - t.mean()
-    stt = float((tc * tc).sum())
-    if stt <= 0:
-        return math.nan, math.nan
-    slope = float((tc * (y - y.mean())).sum() / stt)
-    res = y - y.mean() - slope * tc
-    ss = float((res * res).sum())
-    if n < 4 or ss == 0.0:
-        return slope, 0.0
-    r1 = float((res[1:] * res[:-1]).sum() / ss)
-    r1 = min(max(r1, 0.0), 0.95)
-    n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
-    var = ss / (n - 2) / stt * (n / n_eff)
-    return slope, math.sqrt(var)
+    slope, se = trend_bounds(t, np.asarray(y, dtype=float)[None, :])
+    return float(slope[0]), float(se[0])
+
+
+def trend_bounds(t, ys, first: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """``trend_bound`` of each row of ys over the samples from index ``first`` on (times t),
+    each row over its finite samples."""
+    t = np.ascontiguousarray(t, dtype=float)
+    ys = np.ascontiguousarray(np.atleast_2d(np.asarray(ys, dtype=float)))
+    return _line_fits(t, ys, first)
+
+
+@nb.njit(cache=True)
+def _line_fits(t, ys, first):
+    """The kernel of ``trend_bounds``: per row, the least-squares slope b over its finite
+    samples (t_i, y_i), its residuals e_i, ss = sum e_i^2, r1 = sum e_i e_(i+1) / ss clipped
+    to [0, 0.95], n_eff = max(n (1 - r1) / (1 + r1), 3) and se = sqrt(ss / (n - 2) / stt * n / n_eff)
+    (0 with fewer than 4 samples or ss = 0; NaN with fewer than 3 or stt = 0)."""
+    rows = ys.shape[0]
+    slope = np.full(rows, np.nan)
+    se = np.full(rows, np.nan)
+    tt = np.empty(t.size)
+    yy = np.empty(t.size)
+    for r in range(rows):
+        n = 0
+        for i in range(first, t.size):
+            if np.isfinite(ys[r, i]):
+                tt[n] = t[i]
+                yy[n] = ys[r, i]
+                n += 1
+        if n < 3:
+            continue
+        tm = 0.0
+        ym = 0.0
+        for i in range(n):
+            tm += tt[i]
+            ym += yy[i]
+        tm /= n
+        ym /= n
+        stt = 0.0
+        sty = 0.0
+        for i in range(n):
+            stt += (tt[i] - tm) ** 2
+            sty += (tt[i] - tm) * (yy[i] - ym)
+        if stt <= 0.0:
+            continue
+        b = sty / stt
+        slope[r] = b
+        ss = 0.0
+        s1 = 0.0
+        prev = 0.0
+        for i in range(n):
+            e = yy[i] - ym - b * (tt[i] - tm)
+            ss += e * e
+            if i > 0:
+                s1 += e * prev
+            prev = e
+        if n < 4 or ss == 0.0:
+            se[r] = 0.0
+            continue
+        r1 = min(max(s1 / ss, 0.0), 0.95)
+        n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
+        se[r] = math.sqrt(ss / (n - 2) / stt * (n / n_eff))
+    return slope, se
 
 
 FRONT_VELOCITY_SPAN = 1.0  # s: zeta_f's toe velocity is averaged over one second (SPEC section 4)
@@ -123,25 +167,31 @@ def assess(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: fl
     Returns {"steady": bool, "ratio": {signal: upper bound / tolerance} (ratio <= 1
     passes), "lower": {signal: (|slope| - Z se) * window / tolerance} (> 1: a confident
     drift beyond the tolerance)}."""
-    t = np.asarray(t, dtype=float)
+    t, ys, names = _signals(t, front, depth, station_u)
     start = t[-1] - crit.window if t_start is None else t_start
-    m = (t >= start - 1e-12)
-    tol = tolerances(crit, u_b, h_n)
-    su = np.asarray(station_u, dtype=float).reshape(len(t), -1)[m]
-    signals = {"front": [np.asarray(front, dtype=float)[m]], "depth": [np.asarray(depth, dtype=float)[m]],
-               "velocity": [su[:, j] for j in range(su.shape[1])]}
-    ratio, lower = {}, {}
-    for name, ys in signals.items():
-        up = low = 0.0
-        for y in ys:
-            s, se = trend_bound(t[m], y)
-            if not np.isfinite(s):
-                up = low = math.nan
-                break
-            up = max(up, (abs(s) + z * se) * crit.window / tol[name])
-            low = max(low, (abs(s) - Z * se) * crit.window / tol[name])
-        ratio[name], lower[name] = up, low
-    ok = all(np.isfinite(v) and v <= 1.0 for v in ratio.values())
+    return _assess(t, ys, names, start, crit, tolerances(crit, u_b, h_n), z)
+
+
+def _signals(t, front, depth, station_u) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """The times (ascending) and the signals as rows: front, depth, each station's velocity."""
+    t = np.asarray(t, dtype=float)
+    su = np.asarray(station_u, dtype=float).reshape(len(t), -1)
+    ys = np.vstack([np.asarray(front, dtype=float), np.asarray(depth, dtype=float), su.T])
+    return t, ys, ["front", "depth"] + ["velocity"] * su.shape[1]
+
+
+def _assess(t, ys, names, start, crit, tol, z) -> dict:
+    """``assess`` over the samples from ``start`` on, of the rows of ``_signals``."""
+    slopes, ses = trend_bounds(t, ys, int(np.searchsorted(t, start - 1e-12)))
+    ratio = {"front": 0.0, "depth": 0.0, "velocity": 0.0}
+    lower = dict(ratio)
+    for name, s, se in zip(names, slopes.tolist(), ses.tolist()):
+        if math.isnan(s) or math.isnan(ratio[name]):
+            ratio[name] = lower[name] = math.nan
+            continue
+        ratio[name] = max(ratio[name], (abs(s) + z * se) * crit.window / tol[name])
+        lower[name] = max(lower[name], (abs(s) - Z * se) * crit.window / tol[name])
+    ok = all(v <= 1.0 for v in ratio.values())  # False for NaN
     return {"steady": bool(ok), "ratio": ratio, "lower": lower}
 
 
@@ -161,11 +211,13 @@ def is_steady(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n:
     if t.size < 3:
         return False
     first = max(crit.min_time, t[0])
+    t, ys, names = _signals(t, front, depth, station_u)
+    tol = tolerances(crit, u_b, h_n)
     for k in SPANS:
         start = t[-1] - k * crit.window
         if start < first - 1e-12:
             break
-        if assess(t, front, depth, station_u, crit, u_b, h_n, t_start=start)["steady"]:
+        if _assess(t, ys, names, start, crit, tol, Z)["steady"]:
             return True
     return False
 
