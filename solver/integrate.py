@@ -64,6 +64,11 @@ def kick(u, w, rho, kind, ax, az, drho, drho_prev, n, dt, rho0, clamp_boundary, 
         drho_prev[i] = drho[i]
 
 
+def viscous_cfl(cfl, cfl_viscous=None):
+    """C_nu of the viscous limit: ``cfl_viscous``, or C when it is None (SPEC eq. 7's one C)."""
+    return cfl if cfl_viscous is None else cfl_viscous
+
+
 def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None, viscous_limit=True):
     """(dt, index of the limiting term, (dt1, dt2, dt3)) of SPEC eq. 7:
     dt = min(C dt1, C dt2, C_nu dt3), C = ``cfl``, C_nu = ``cfl_viscous`` (default C, when
@@ -72,7 +77,7 @@ def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None, viscous_limit=True):
     dt1 = math.sqrt(h / amax) if amax > 0 else math.inf
     dt2 = h / (c0 + vmax)
     dt3 = h * h / nu
-    c_nu = (cfl if cfl_viscous is None else cfl_viscous) if viscous_limit else math.inf
+    c_nu = viscous_cfl(cfl, cfl_viscous) if viscous_limit else math.inf
     scaled = (cfl * dt1, cfl * dt2, c_nu * dt3)
     k = int(np.argmin(scaled))
     return scaled[k], k, (dt1, dt2, dt3)

@@ -261,9 +261,9 @@ class Scene(YamlData):
         update = self.physics.viscous_update
         if update != "auto":
             return update == "implicit"
-        from .integrate import time_step  # SPEC eq. 7's limits, at rest
+        from .integrate import time_step, viscous_cfl  # SPEC eq. 7's limits, at rest
         _, _, (_, dt_acoustic, dt_viscous) = time_step(self.cfl, self.h, 0.0, 0.0, self.c0, self.nu)
-        c_nu = self.cfl if self.cfl_viscous is None else self.cfl_viscous
+        c_nu = viscous_cfl(self.cfl, self.cfl_viscous)
         return self.cfl * dt_acoustic >= AUTO_IMPLICIT_RATIO * c_nu * dt_viscous
 
     @property

@@ -14,6 +14,7 @@ from .scene import Scene
 _SORTED = ("x", "z", "u", "w", "rho", "mass", "cell_volume", "drho_prev", "kind", "wall", "gx", "gz",
            "wnx", "wnz", "pid")
 _SHIFT = ("shift_dx", "shift_dz")  # the last shift, pending its density correction
+_IMPLICIT = ("implicit_cx", "implicit_cz")  # the last implicit correction, CG's next start
 
 
 def default_domain(scene: Scene) -> tuple[float, float, float, float]:
@@ -95,7 +96,8 @@ class Simulation:
                                                 self.strain_correction, self.volume_relaxation > 0)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ())
-                              + (("gamma_p",) if self.strain_correction else ()))
+                              + (("gamma_p",) if self.strain_correction else ())
+                              + (_IMPLICIT if self.implicit else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
@@ -117,6 +119,8 @@ class Simulation:
         if self.implicit:
             self.rows = implicit.rows_for(self.nthreads, self.n, cap)
             self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
+        self.implicit_cx = np.zeros(self.n if self.implicit else 1)
+        self.implicit_cz = np.zeros(self.n if self.implicit else 1)
         self.acc = np.zeros((self.nthreads, self.n, self.nq))
         self.out = np.zeros((self.nq, self.n))
         self.vmax_t = np.zeros(self.nthreads)
@@ -222,8 +226,8 @@ class Simulation:
         n = self.n_active
         implicit.sort_pairs(*self.pairs[:3], self.pairs.count, self.mass, n, self.rows)
         it, res = implicit.solve(*self.rows[:3], o[self.nq - 1], self.mass, self.kind, dt, o[forces.AX],
-                                 o[forces.AZ], n, implicit.TOLERANCE, implicit.MAX_ITERATIONS,
-                                 self.solver_work)
+                                 o[forces.AZ], self.implicit_cx, self.implicit_cz, n, implicit.TOLERANCE,
+                                 implicit.MAX_ITERATIONS, self.solver_work)
         self.solver_iterations += it
         if not res <= implicit.TOLERANCE:
             return (f"implicit viscous solve: relative residual {res:.3g} after {it} iterations "
@@ -341,8 +345,8 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFT + ("nu_p", "gamma_p", "nu_max_now", "t", "steps", "info", "dt_first", "n_active",
-                                 "reason")
+    _STATE = _SORTED + _SHIFT + _IMPLICIT + ("nu_p", "gamma_p", "nu_max_now", "t", "steps", "info", "dt_first",
+                                             "n_active", "reason")
 
     def state(self) -> dict:
         """Everything needed to resume exactly where this simulation stands."""
