@@ -10,6 +10,7 @@ import sys
 import tempfile
 from dataclasses import replace
 
+import numba as nb
 import numpy as np
 import xarray as xr
 
@@ -350,6 +351,7 @@ class Checkpointer:
     def __init__(self, path, interval: float, key: str):
         self.path, self.interval, self.key = os.fspath(path), interval, key
         self.next = None
+        self.start = None  # (flux ratio, how the start's depth was chosen), saved with the state
 
     def __call__(self, runner: Runner):
         if self.next is None:
@@ -362,7 +364,8 @@ class Checkpointer:
         state = {"key": self.key, "sim": runner.sim.state(), "res": runner.res,
                  "next_out": runner.next_out, "next_diag": runner.next_diag,
                  "next_monitor": runner.next_monitor, "monitors": runner.monitors,
-                 "next_checkpoint": self.next + self.interval, "wall_time": runner.elapsed()}
+                 "next_checkpoint": self.next + self.interval, "wall_time": runner.elapsed(),
+                 "start": self.start}
         folder = os.path.dirname(os.path.abspath(self.path))
         os.makedirs(folder, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=os.path.basename(self.path) + ".", suffix=".tmp", dir=folder)
@@ -370,18 +373,27 @@ class Checkpointer:
             pickle.dump(state, fh, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(tmp, self.path)
 
-    def restore(self, runner: Runner) -> bool:
-        """Load a matching checkpoint into the runner; False if none (or another case's)."""
+    def load(self) -> dict | None:
+        """The checkpoint's state when it matches this case, solver and thread count; None
+        when there is none, it cannot be read, or it is another's (with a note)."""
         if not os.path.exists(self.path):
-            return False
+            return None
         try:
             with open(self.path, "rb") as fh:
                 state = pickle.load(fh)
         except Exception:
-            return False
+            return None
         if state.get("key") != self.key:
             print(f"note: ignoring the checkpoint {self.path}: written for another case, solver "
                   "version or thread count; starting from t = 0", file=sys.stderr)
+            return None
+        return state
+
+    def restore(self, runner: Runner, state: dict | None = None) -> bool:
+        """Load a matching checkpoint (``state``, or read by ``load``) into the runner; False
+        if none (or another case's)."""
+        state = self.load() if state is None else state
+        if state is None:
             return False
         runner.sim.restore(state["sim"])
         runner.res = state["res"]
@@ -432,7 +444,15 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
                 print(f"warning: warm start not possible, {warm_note}", file=sys.stderr)
     if state is None and warm_note:
         case = replace(case, start="lubrication", warm_from=None)
-    flux_ratio, depth_note = start_flux_ratio(case, state, quiet)
+    ckpt = None
+    saved = None
+    if checkpoint is not None:
+        ckpt = Checkpointer(checkpoint, case.checkpoint_interval, checkpoint_key(case, nb.get_num_threads()))
+        saved = ckpt.load()
+    if saved is not None and saved.get("start") is not None:
+        flux_ratio, depth_note = saved["start"]  # the start's film is not run again
+    else:
+        flux_ratio, depth_note = start_flux_ratio(case, state, quiet)
     used = math.isfinite(flux_ratio)
     scene = build_scene(case, state, flux_ratio if used else 1.0)
     parts = build_particles(scene)
@@ -444,11 +464,10 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     sim = Simulation(scene, parts)
     monitor = FrontMonitor(case)
     runner = Runner(scene, sim, monitors=[monitor], final_snapshot=True)
-    ckpt = None
     resumed = False
-    if checkpoint is not None:
-        ckpt = Checkpointer(checkpoint, case.checkpoint_interval, checkpoint_key(case, runner.res.threads))
-        resumed = ckpt.restore(runner)
+    if ckpt is not None:
+        ckpt.start = (flux_ratio, depth_note)
+        resumed = ckpt.restore(runner, saved) if saved is not None else False
         monitor = runner.monitors[0]
     res = runner.run(quiet=quiet, on_step=ckpt)
     front_ds = monitor.dataset()

@@ -306,3 +306,27 @@ def test_start_velocity_is_validated():
         paper(start_velocity="moving")
     with pytest.raises(SceneError, match="case.start_velocity: a warm start"):
         paper(start="warm", warm_from="x.nc", start_velocity="lubrication")
+
+
+@pytest.mark.slow
+def test_a_resumed_run_takes_its_start_from_the_checkpoint(tmp_path, monkeypatch):
+    """The start's periodic film (seconds at dp = 1 mm, a minute at 0.25 mm) is not run again
+    when a run resumes: its flux ratio and note come from the checkpoint."""
+    from solver import film_depth
+    from solver.front import run_front
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        steady = {**yaml.safe_load(fh)["steady"], "max_time": 0.05}
+    c = paper(dp=4.0e-3, checkpoint_interval=0.02, steady=steady)
+    assert c.start_depth == "film"
+    ckpt = tmp_path / "run.ckpt"
+    first = run_front(c, checkpoint=ckpt)
+    assert ckpt.exists() and np.isfinite(first.attrs["start_flux_ratio"])
+
+    def no_film(case):
+        raise AssertionError("the film ran again")
+
+    monkeypatch.setattr(film_depth, "scheme_normal_depth", no_film)
+    again = run_front(c, checkpoint=ckpt)
+    assert again.attrs["resumed_from_checkpoint"] == 1
+    assert again.attrs["start_flux_ratio"] == first.attrs["start_flux_ratio"]
+    assert again.attrs["start_depth"] == first.attrs["start_depth"]
