@@ -23,8 +23,8 @@ times u_max within 0.225 s. Multiplied by m_a the system is
 symmetric positive definite (m_a c_ab = m_a m_b k_ab with k symmetric), and
 Jacobi-preconditioned conjugate gradients solve it for both velocity components, starting
 from the explicit step plus the previous step's implicit correction, delta = dt (a + c) with
-c = delta / dt - a of that step (carried with the particles): 21 % fewer iterations at
-dp = 0.25 mm, Ch = 1.8 (``benchmarks/cg_solve.py``).
+c = delta / dt - a of that step (carried with the particles): a fifth fewer iterations
+(12.2 against 15.2 a step at dp = 0.25 mm, Ch = 1.8, ``benchmarks/cg_solve.py``).
 
 The pair loop lists the fluid pairs with k_ab = c_ab / m_b (``forces.PairList``, per thread,
 each pair once) and sums the diagonal sum_b c_ab; ``sort_pairs`` arranges the list by rows
