@@ -26,8 +26,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def capture(dp: float, ch: float, steps: int, systems: int) -> tuple[list[dict], float, int]:
-    """Step the case and keep the CG systems of its last ``systems`` steps."""
+def capture(dp: float, ch: float, steps: int, systems: int):
+    """Step the case and keep the CG systems of its last ``systems`` steps: (the systems,
+    the belt speed, the simulation, its own ``_solve_viscous``)."""
     from solver import forces, implicit
     from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
     from solver.build import build_particles

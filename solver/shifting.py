@@ -177,22 +177,22 @@ def near_surface(x, z, kind, surface, cl, n_active, h, near):
 
 
 @nb.njit(cache=True)
-def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, nx, nz):
-    """(nx, nz)[i] = the unit vector along sum_j (1 - q_ij/2)^4 n_j over the free-surface
-    particles j within 2h of fluid particle i (i itself included), n_j = -gradC_j / |gradC_j|
-    their outward normals; zero where there is none. Scattered from the surface particles,
-    which are few: serial."""
+def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, near, nx, nz):
+    """``near_surface``'s flags, and in the same pass (nx, nz)[i] = the unit vector along
+    sum_j (1 - q_ij/2)^4 n_j over the free-surface particles j within 2h of fluid particle i
+    (i itself included), n_j = -gradC_j / |gradC_j| their outward normals; zero where there is
+    none. Scattered from the surface particles, which are few: serial."""
     four_h2 = 4.0 * h * h
     for i in range(n_active):
+        near[i] = 0
         nx[i] = 0.0
         nz[i] = 0.0
     for j in range(n_active):
         if not surface[j]:
             continue
+        near[j] = 1
         g = math.sqrt(gcx[j] * gcx[j] + gcz[j] * gcz[j])
-        if g == 0.0:
-            continue
-        ox, oz = -gcx[j] / g, -gcz[j] / g
+        ox, oz = (-gcx[j] / g, -gcz[j] / g) if g > 0.0 else (0.0, 0.0)
         ix, iz = cell_of(cl, x[j], z[j])
         for ddx in range(-1, 2):
             for ddz in range(-1, 2):
@@ -206,6 +206,7 @@ def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, nx, nz):
                     ez = z[i] - z[j]
                     r2 = ex * ex + ez * ez
                     if r2 < four_h2:
+                        near[i] = 1
                         s = 1.0 - 0.5 * math.sqrt(r2) / h
                         wgt = s * s * s * s
                         nx[i] += wgt * ox

@@ -275,16 +275,17 @@ class Simulation:
             shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.cells,
                                   self.n_active, self.h, sh.surface_threshold, shifting.SCAN_UPPER,
                                   self.surface_flag)
-            shifting.near_surface(self.x, self.z, self.kind, self.surface_flag, self.cells,
-                                  self.n_active, self.h, self.near_flag)
             D = 0.5 * A * self.h * self.h
-            if sh.near_surface == "tangential":
+            if sh.near_surface == "tangential":  # the near-surface flags with the normals, one pass
                 shifting.surface_normals(self.x, self.z, self.kind, self.surface_flag, gcx, gcz, self.cells,
-                                         self.n_active, self.h, self.surface_nx, self.surface_nz)
+                                         self.n_active, self.h, self.near_flag, self.surface_nx,
+                                         self.surface_nz)
                 shifting.lind_shift_tangential(self.kind, gcx, gcz, self.near_flag, self.surface_flag, self.surface_nx,
                                                self.surface_nz, wnx, wnz, self.wall_s0, self.n_active, D, clip,
                                                self.shift_dx, self.shift_dz)
             else:
+                shifting.near_surface(self.x, self.z, self.kind, self.surface_flag, self.cells,
+                                      self.n_active, self.h, self.near_flag)
                 shifting.lind_shift(self.kind, gcx, gcz, self.near_flag, wnx, wnz, self.wall_s0,
                                     self.n_active, D, clip, self.shift_dx, self.shift_dz)
         # the density follows the volume change of the shift at the next evaluation
