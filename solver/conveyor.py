@@ -37,9 +37,8 @@ class Probes:
 @dataclass
 class Steady:
     window: float = 1.0  # s: trailing window the drift tolerances apply to
-    front_velocity: float = 0.01  # |toe velocity| / u_b
+    front_velocity: float = 0.01  # drift of the equivalent front and each station's / (u_b window)
     depth: float = 0.005  # uniform-depth change over the window / h_n
-    velocity: float = 0.02  # station depth-mean u* change over the window
     average: float = 2.0  # s: averaging window once steady
     max_time: float = 30.0  # s: give up (status not_steady) after this
     min_time: float = 0.5  # s after the end of the belt ramp before steadiness counts
@@ -151,7 +150,7 @@ class ConveyorCase(YamlData):
     def criteria(self) -> SteadyCriteria:
         s = self.steady
         return SteadyCriteria(window=s.window, front_velocity=s.front_velocity, depth=s.depth,
-                              velocity=s.velocity, min_time=self.ramp_end + s.min_time, dp=self.dp)
+                              min_time=self.ramp_end + s.min_time, dp=self.dp)
 
 
 def case_from_dict(data) -> ConveyorCase:
@@ -217,7 +216,7 @@ def validate_case(c: ConveyorCase) -> None:
             f"case.fluid_length: {c.fluid_length:g} h_n leaves no room for probes up to "
             f"x* = {p.x_star_max:g} (need fluid_length >= x_star_max + 2)")
     s = c.steady
-    for key in ("window", "front_velocity", "depth", "velocity", "average", "max_time"):
+    for key in ("window", "front_velocity", "depth", "average", "max_time"):
         positive(getattr(s, key), f"case.steady.{key}")
     if s.min_time < 0:
         raise SceneError("case.steady.min_time: must be >= 0")

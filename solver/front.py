@@ -104,7 +104,9 @@ class FrontMonitor:
         self.surface: list[np.ndarray] = []  # z_max over x_star
         self.velocity: list[np.ndarray] = []  # u* over (station, z_star)
         self.station_u: list[np.ndarray] = []  # depth-mean u* of each station
+        self.station_front: list[np.ndarray] = []  # equivalent front from each station's anchor
         self.x_anchor = math.nan  # x0 of the equivalent front, set at the first sample
+        self.x_station_anchor = np.full(self.stations.size, math.nan)  # lab-fixed, at the first sample
 
     @property
     def t_steady(self) -> float:
@@ -142,7 +144,9 @@ class FrontMonitor:
         depth = float(np.nanmean(surface[zone])) if np.isfinite(surface[zone]).any() else math.nan
         if math.isnan(self.x_anchor):
             self.x_anchor = max(toe - FRONT_ANCHOR * hn, 0.5 * toe)  # inside the fluid
+            self.x_station_anchor = np.maximum(toe - self.stations * hn, 0.5 * toe)
         front_eq = equivalent_front(xf, vol, self.x_anchor, hn, sim.h)
+        station_front = np.array([equivalent_front(xf, vol, xa, hn, sim.h) for xa in self.x_station_anchor])
         # velocity lines at the stations
         x_station = toe - self.stations * hn
         px = np.repeat(x_station, self.z_star.size)
@@ -164,7 +168,7 @@ class FrontMonitor:
             if core.size:
                 disorder = fs.disorder(core).mean(axis=1)
         return {"toe": toe, "front_position": front, "front_equivalent": front_eq, "uniform_depth": depth,
-                "enclosed_area": enclosed, "station_u": station_u,
+                "enclosed_area": enclosed, "station_u": station_u, "station_front": station_front,
                 "mass_area": mass_area, "number_density": number_density,
                 "zone_enclosed": zone_enclosed, "zone_mass": zone_mass, "disorder": disorder,
                 "surface": surface, "velocity": u_star}
@@ -183,13 +187,13 @@ class FrontMonitor:
             if k > 1 and t[-1] - span < max(crit.min_time, t[0]) - 1e-9:
                 break
             r = steady.assess(t, self.series["front_equivalent"], self.series["uniform_depth"],
-                              self.station_means(), crit, self.case.belt.speed, self.case.h_n,
+                              self.station_fronts(), crit, self.case.belt.speed, self.case.h_n,
                               t_start=t[-1] - span)["ratio"]
             worst = max((v if np.isfinite(v) else math.inf) for v in r.values())
             if best is None or worst < best[0]:
                 best = (worst, span, r)
         _, span, r = best
-        names = {"front": "front position", "depth": "uniform depth", "velocity": "station velocity"}
+        names = {"front": "front position", "depth": "uniform depth", "station": "station front"}
         failing = [f"{names[k]} {v:.1f}x" for k, v in r.items() if not (np.isfinite(v) and v <= 1.0)]
         text = (f"over the final {span:g} s, drift bound / tolerance: " + ", ".join(failing)) if failing else \
             f"the final {span:g} s meet the tolerances"
@@ -202,6 +206,10 @@ class FrontMonitor:
             text += (f"; detections at {', '.join(f'{v:.2f}' for v in withdrawn)} s withdrawn "
                      "(their averaging windows drifted or stayed too noisy)")
         return text
+
+    def station_fronts(self) -> np.ndarray:
+        """Equivalent front from each station's lab-fixed anchor over time, (time, station)."""
+        return np.asarray(self.station_front, dtype=float).reshape(len(self.t), self.stations.size)
 
     def station_means(self) -> np.ndarray:
         """Depth-mean u* of each station over time, (time, station) (``strip_mean_velocity``)."""
@@ -219,13 +227,14 @@ class FrontMonitor:
         self.surface.append(s["surface"])
         self.velocity.append(s["velocity"])
         self.station_u.append(s["station_u"])
+        self.station_front.append(s["station_front"])
         drift = s["enclosed_area"] / s["mass_area"] - 1.0
         if abs(drift) > self.case.max_area_drift:
             return ("diverged", f"t = {sim.t:.6g} s: enclosed area differs from the mass-implied "
                     f"area by {100 * drift:+.1f} % (max_area_drift = {self.case.max_area_drift:g})")
         if self.state != "steady":
             self.state = self.tracker.update(self.t, self.series["front_equivalent"],
-                                             self.series["uniform_depth"], self.station_means())
+                                             self.series["uniform_depth"], self.station_fronts())
             if self.state == "steady" and self.case.steady.stop:
                 return ("completed", "")
         return None
@@ -248,8 +257,12 @@ class FrontMonitor:
                                   "the steady detection's front signal"}),
             "station_mean_velocity": (("time", "station"), self.station_means(),
                                       {"units": "1", "long_name": "depth-mean u* at the station: volume-weighted mean "
-                                       "of the fluid particles within +-2h of it; the steady detection's "
-                                       "velocity signal"}),
+                                       "of the fluid particles within +-2h of it"}),
+            "station_front": (("time", "station"),
+                              np.asarray(self.station_front).reshape(t.size, self.stations.size),
+                              {"units": "m", "long_name": "x_s + fluid area downstream of x_s / h_n, lab frame, "
+                               "x_s fixed at each station's x* upslope of the first toe (half-way to the wall if "
+                               "nearer); the steady detection's station signals"}),
             "uniform_depth": (("time",), np.asarray(self.series["uniform_depth"]),
                               {"units": "m", "long_name": "mean free-surface elevation over the uniform zone"}),
             "enclosed_area": (("time",), np.asarray(self.series["enclosed_area"]),
@@ -314,7 +327,7 @@ class FrontMonitor:
             steady_found = bool(np.isfinite(self.t_steady) and self.t_steady <= final + 1e-9
                                 and self.tracker.verify(t, self.series["front_equivalent"],
                                                         self.series["uniform_depth"],
-                                                        self.station_means(), final))
+                                                        self.station_fronts(), final))
         ds.attrs["steady_state_time_s"] = float(self.t_steady) if steady_found else math.nan
         ds.attrs["steady"] = int(steady_found)
         ds.attrs["steady_withdrawn_s"] = [float(a) for a, _ in self.tracker.rejected] or ""

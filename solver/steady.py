@@ -17,11 +17,16 @@ is too noisy to judge, not drifting: it is extended, and the longer window must 
 at 2 se, up to the longest detection span (SPANS[-1] windows). A confident drift at the
 nominal end, or a window that reaches that length without passing, withdraws the detection.
 
+Signals: the equivalent front (front), the uniform depth (depth) and one equivalent front
+from each station (station): x_s + (fluid area downstream of x_s) / h_n, x_s fixed in the lab
+frame. A steady front holds every one of them; together they hold the area between the
+stations, i.e. the front's shape. (A station's depth-mean velocity is the time derivative of
+that area, q / h: the same balance, with the particles' flux noise undamped.)
+
 Tolerances (the probes of a coarse run fluctuate by a fraction of dp, so a tolerance fixed
 in h_n or u_b alone cannot be met at every dp):
-  front:    drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
-  depth:    drift <= max(depth * h_n, NOISE_DP * dp)
-  velocity: drift of each station's depth-mean u* <= velocity
+  front, station: drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
+  depth:          drift <= max(depth * h_n, NOISE_DP * dp)
 """
 from __future__ import annotations
 
@@ -41,7 +46,6 @@ class SteadyCriteria:
     window: float = 1.0  # s
     front_velocity: float = 0.01  # fraction of u_b
     depth: float = 0.005  # fraction of h_n over the window
-    velocity: float = 0.02  # change of station depth-mean u* over the window
     min_time: float = 0.0  # s: not before (e.g. the end of the belt ramp)
     dp: float = 0.0  # m: particle spacing, for the noise floor of the tolerances
 
@@ -153,12 +157,11 @@ def drifts(t, toe, depth, station_u, window: float) -> dict[str, float]:
 def tolerances(crit: SteadyCriteria, u_b: float, h_n: float) -> dict[str, float]:
     """Allowed drift over one window of each signal (see the module docstring)."""
     floor = NOISE_DP * crit.dp
-    return {"front": max(crit.front_velocity * u_b * crit.window, floor),
-            "depth": max(crit.depth * h_n, floor),
-            "velocity": crit.velocity}
+    front = max(crit.front_velocity * u_b * crit.window, floor)
+    return {"front": front, "depth": max(crit.depth * h_n, floor), "station": front}
 
 
-def assess(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float,
+def assess(t, front, depth, stations, crit: SteadyCriteria, u_b: float, h_n: float,
            t_start: float | None = None, z: float = Z) -> dict:
     """Confident drift bounds against tolerances over [t_start, t_end] (default: the
     trailing ``crit.window``). Drift bounds are scaled to the span of ``crit.window``, so a
@@ -167,23 +170,23 @@ def assess(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: fl
     Returns {"steady": bool, "ratio": {signal: upper bound / tolerance} (ratio <= 1
     passes), "lower": {signal: (|slope| - Z se) * window / tolerance} (> 1: a confident
     drift beyond the tolerance)}."""
-    t, ys, names = _signals(t, front, depth, station_u)
+    t, ys, names = _signals(t, front, depth, stations)
     start = t[-1] - crit.window if t_start is None else t_start
     return _assess(t, ys, names, start, crit, tolerances(crit, u_b, h_n), z)
 
 
-def _signals(t, front, depth, station_u) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """The times (ascending) and the signals as rows: front, depth, each station's velocity."""
+def _signals(t, front, depth, stations) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """The times (ascending) and the signals as rows: front, depth, each station's front."""
     t = np.asarray(t, dtype=float)
-    su = np.asarray(station_u, dtype=float).reshape(len(t), -1)
-    ys = np.vstack([np.asarray(front, dtype=float), np.asarray(depth, dtype=float), su.T])
-    return t, ys, ["front", "depth"] + ["velocity"] * su.shape[1]
+    sf = np.asarray(stations, dtype=float).reshape(len(t), -1)
+    ys = np.vstack([np.asarray(front, dtype=float), np.asarray(depth, dtype=float), sf.T])
+    return t, ys, ["front", "depth"] + ["station"] * sf.shape[1]
 
 
 def _assess(t, ys, names, start, crit, tol, z) -> dict:
     """``assess`` over the samples from ``start`` on, of the rows of ``_signals``."""
     slopes, ses = trend_bounds(t, ys, int(np.searchsorted(t, start - 1e-12)))
-    ratio = {"front": 0.0, "depth": 0.0, "velocity": 0.0}
+    ratio = {"front": 0.0, "depth": 0.0, "station": 0.0}
     lower = dict(ratio)
     for name, s, se in zip(names, slopes.tolist(), ses.tolist()):
         if math.isnan(s) or math.isnan(ratio[name]):
@@ -203,7 +206,7 @@ def _assess(t, ys, names, start, crit, tol, z) -> dict:
 SPANS = tuple(range(1, 9))
 
 
-def is_steady(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
+def is_steady(t, front, depth, stations, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
     """True when a trailing span of SPANS windows, after ``crit.min_time``, meets every
     tolerance with confidence. A noisy signal needs a longer span to show that its drift
     is small; a real drift fails on every span."""
@@ -211,7 +214,7 @@ def is_steady(t, front, depth, station_u, crit: SteadyCriteria, u_b: float, h_n:
     if t.size < 3:
         return False
     first = max(crit.min_time, t[0])
-    t, ys, names = _signals(t, front, depth, station_u)
+    t, ys, names = _signals(t, front, depth, stations)
     tol = tolerances(crit, u_b, h_n)
     for k in SPANS:
         start = t[-1] - k * crit.window
@@ -243,16 +246,16 @@ class SteadyTracker:
         """The longest an averaging window may be extended to."""
         return max(self.average, SPANS[-1] * self.crit.window)
 
-    def update(self, t, front, depth, station_u) -> str:
+    def update(self, t, front, depth, stations) -> str:
         t_end = float(np.asarray(t)[-1])
         if math.isnan(self.t_steady):
-            if is_steady(t, front, depth, station_u, self.crit, self.u_b, self.h_n):
+            if is_steady(t, front, depth, stations, self.crit, self.u_b, self.h_n):
                 self.t_steady = t_end
                 return "averaging"
             return "transient"
         if t_end < self.t_steady + self.average - 1e-9:
             return "averaging"
-        verdict = self.judge_window(t, front, depth, station_u, self.t_steady)
+        verdict = self.judge_window(t, front, depth, stations, self.t_steady)
         if verdict == "steady":
             self.t_end = t_end
             return "steady"
@@ -262,14 +265,14 @@ class SteadyTracker:
         self.t_steady = math.nan
         return "transient"
 
-    def judge_window(self, t, front, depth, station_u, t_start: float) -> str:
+    def judge_window(self, t, front, depth, stations, t_start: float) -> str:
         """The averaging window from t_start to the last sample: "steady" when it meets the
         tolerances (the nominal window at 1 se, an extended one at 2 se); otherwise, at the
         nominal end, "drift" when a signal's drift exceeds its tolerance with confidence
         (lower bound |slope| - 2 se) and "noisy" when none does; past it, "extended"."""
         t = np.asarray(t, dtype=float)
         extended = t.size > 1 and t[-2] >= t_start + self.average - 1e-9  # past its nominal end
-        r = assess(t, front, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
+        r = assess(t, front, depth, stations, self.crit, self.u_b, self.h_n, t_start=t_start,
                    z=Z if extended else VERIFY_Z)
         if r["steady"]:
             return "steady"
@@ -277,7 +280,7 @@ class SteadyTracker:
             return "extended"
         return "noisy" if all(np.isfinite(v) and v <= 1.0 for v in r["lower"].values()) else "drift"
 
-    def verify(self, t, front, depth, station_u, t_start: float) -> bool:
+    def verify(self, t, front, depth, stations, t_start: float) -> bool:
         """Whether the samples from t_start on meet the tolerances (a fixed-end window, 1 se)."""
-        return assess(t, front, depth, station_u, self.crit, self.u_b, self.h_n, t_start=t_start,
+        return assess(t, front, depth, stations, self.crit, self.u_b, self.h_n, t_start=t_start,
                       z=VERIFY_Z)["steady"]
