@@ -52,15 +52,12 @@ def front_position(ds: xr.Dataset) -> np.ndarray:
 def replay(ds: xr.Dataset, case) -> tuple[float, list]:
     """(start of the first verified averaging window, withdrawn detections) of the current
     detector on the stored series (runs written before the detector's own signals existed:
-    the h_n / 2 front position and the mean of the station's samples)."""
+    the h_n / 2 front position for the equivalent front, and the front for the station
+    fronts, which such runs do not hold)."""
     t = ds.time.values
     front = ds.front_equivalent.values if "front_equivalent" in ds else front_position(ds)
     depth = ds.uniform_depth.values
-    if "station_mean_velocity" in ds:
-        su = ds.station_mean_velocity.values
-    else:
-        with np.errstate(all="ignore"):
-            su = np.nanmean(ds.velocity_star.values, axis=2)
+    su = ds.station_front.values if "station_front" in ds else front[:, None]
     tr = SteadyTracker(case.criteria(), case.belt.speed, case.h_n, case.steady.average)
     for k in range(2, t.size):
         if tr.update(t[:k + 1], front[:k + 1], depth[:k + 1], su[:k + 1]) == "steady":

@@ -7,8 +7,8 @@ rate, times the window, must not exceed it. se(slope) comes from the fit's resid
 widened for their correlation from sample to sample (effective sample count
 n (1 - r1) / (1 + r1), r1 the lag-1 autocorrelation of the residuals, r1 >= 0). So a trend
 is weighed against the signal's own sampling noise: noise alone lengthens the time to
-detection, never shortens it, and a drift larger than the tolerance never passes however
-noisy the signal.
+detection. (A lag-1 estimate understates slow wander: with a 3 s correlation time, a drift
+of 1.25 times the tolerance passed in 3 of 40 synthetic series; twice it in none.)
 
 Verification: once detected at t_s, the averaging window [t_s, t_s + average] must itself
 meet the tolerances (1 se: the detection was already confident). A window that fails there

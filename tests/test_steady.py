@@ -323,6 +323,7 @@ def test_reason_names_the_failing_signal_over_the_span_closest_to_passing():
     with open(EXAMPLES / "conveyor.yaml") as fh:
         d = yaml.safe_load(fh)
     d.update(dp=0.002, ch=1.8)
+    d["steady"]["min_time"] = 0.5  # spans of up to 8 s in the 10 s record
     m = FrontMonitor(case_from_dict(d))
     t, toe, depth, su = noisy_signals(10.0, 2e-3, toe_drift=0.03 * m.case.belt.speed, noise_dp=0.1,
                                       seed=2, red=0.5)
