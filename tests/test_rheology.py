@@ -12,7 +12,7 @@ import pytest
 from solver import exact, rheology
 from solver.scene import SceneError
 from solver.simulation import Simulation
-from tests.conftest import example_scene
+from tests.conftest import example_dict, example_scene
 
 L_CHANNEL = 1.0e-3
 # (measured, bound) at t = 0.6 s: the L2 error falls to 2.10 % at 1.2 s and stays at 2.0-2.2 %
@@ -44,11 +44,20 @@ def l2(u, ue, scale):
     return float(np.sqrt(np.mean((u - ue) ** 2)) / scale)
 
 
-def film_errors(name: str):
+def periodic_strip(name: str, width: float) -> dict:
+    """Changes that run a film example on a periodic strip ``width`` wide: the film is
+    uniform along x, so the strip only sets how many columns the row means average."""
+    d = example_dict(name)
+    return {"fluid": {"blocks": [{**d["fluid"]["blocks"][0], "x": [0.0, width]}]},
+            "walls": [{**w, "x": [0.0, width]} for w in d["walls"]], "periodic_x": [0.0, width]}
+
+
+def film_errors(name: str, width: float | None = None):
     """(L2 error of u over the plug velocity, largest deviation of a particle above the exact
     yield surface from the plug velocity, relative error of the computed plug thickness) of a
-    Herschel-Bulkley film example at its end time."""
-    scene, z, u, gamma, nu = steady_state(name)
+    Herschel-Bulkley film example at its end time (on a periodic strip ``width`` wide if
+    given, else the example's)."""
+    scene, z, u, gamma, nu = steady_state(name, **(periodic_strip(name, width) if width else {}))
     f = scene.fluid
     H = f.blocks[0].z[1]
     g_s = scene.gravity[0]
@@ -130,14 +139,16 @@ def test_effective_viscosity_law():
 @pytest.mark.slow
 def test_herschel_bulkley_film_at_forty_particles_meets_the_targets():
     """hb_film_fine.yaml: 40 particles across, mu_max 105 times the bed viscosity, the
-    corrected strain rate, implicit viscosity at cfl 0.4, to 1.2 s. Targets: L2 error below
+    corrected strain rate, implicit viscosity at cfl 0.4, to 1.2 s, here on a strip of 10
+    columns (the example's 40 give the same three figures to the printed digit, in 2.5 times
+    the time). Targets: L2 error below
     2 % of the plug velocity (measured 1.47 %; 1.48 % at cfl 0.2, and 1.50-1.66 % from 1.5 s
     to 3 s) and the computed plug within 5 % of the exact 7.73 mm (measured -1.5 %; -1.2 to
     -1.7 % to 3 s at cfl 0.2). Every particle
     above the exact yield surface moves within 2.5 % of the plug velocity (measured 1.92 %:
     the capped plug creeps by rho g sin(theta) (H - h0)^2 / (2 mu_max) = 0.4 %, and the
     yielded layer still over-shears by about 1 %)."""
-    err, plug_speed, plug = film_errors("hb_film_fine")
+    err, plug_speed, plug = film_errors("hb_film_fine", width=0.005)
     assert err < 0.02, err
     assert abs(plug) < 0.05, plug
     assert plug_speed < 0.025, plug_speed
