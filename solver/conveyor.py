@@ -155,6 +155,10 @@ class ConveyorCase(YamlData):
 
 
 def case_from_dict(data) -> ConveyorCase:
+    steady = data.get("steady") if isinstance(data, dict) else None
+    if isinstance(steady, dict) and "velocity" in steady:
+        raise SceneError("case.steady.velocity: no longer a key; the steady detection holds each station's "
+                         "area to steady.front_velocity (docs/conveyor.md, 'Steady state and averaging')")
     case = parse_into(ConveyorCase, data, "case")
     validate_case(case)
     return case

@@ -152,6 +152,8 @@ def test_case_errors_name_the_key():
         paper(shifting="magic")
     with pytest.raises(SceneError, match="case.shift_min_speed"):
         paper(shift_min_speed=-0.5)
+    with pytest.raises(SceneError, match="case.steady.velocity: no longer a key.*front_velocity"):
+        paper(steady={"window": 1.0, "velocity": 0.02})
 
 
 def test_shift_min_speed_is_a_fraction_of_the_belt_speed_for_skillen_only():
