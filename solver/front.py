@@ -258,8 +258,7 @@ class FrontMonitor:
             "station_mean_velocity": (("time", "station"), self.station_means(),
                                       {"units": "1", "long_name": "depth-mean u* at the station: volume-weighted mean "
                                        "of the fluid particles within +-2h of it"}),
-            "station_front": (("time", "station"),
-                              np.asarray(self.station_front).reshape(t.size, self.stations.size),
+            "station_front": (("time", "station"), self.station_fronts(),
                               {"units": "m", "long_name": "x_s + fluid area downstream of x_s / h_n, lab frame, "
                                "x_s fixed at each station's x* upslope of the first toe (half-way to the wall if "
                                "nearer); the steady detection's station signals"}),
@@ -402,19 +401,14 @@ class Checkpointer:
             return None
         return state
 
-    def restore(self, runner: Runner, state: dict | None = None) -> bool:
-        """Load a matching checkpoint (``state``, or read by ``load``) into the runner; False
-        if none (or another case's)."""
-        state = self.load() if state is None else state
-        if state is None:
-            return False
+    def restore(self, runner: Runner, state: dict) -> None:
+        """Put a checkpoint's state (from ``load``) into the runner."""
         runner.sim.restore(state["sim"])
         runner.res = state["res"]
         runner.res.wall_time = state["wall_time"]
         runner.next_out, runner.next_diag = state["next_out"], state["next_diag"]
         runner.next_monitor, runner.monitors = state["next_monitor"], state["monitors"]
         self.next = state["next_checkpoint"]
-        return True
 
 
 def start_flux_ratio(case: ConveyorCase, warm_state, quiet: bool = True) -> tuple[float, str]:
@@ -480,7 +474,9 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     resumed = False
     if ckpt is not None:
         ckpt.start = (flux_ratio, depth_note)
-        resumed = ckpt.restore(runner, saved) if saved is not None else False
+        resumed = saved is not None
+        if resumed:
+            ckpt.restore(runner, saved)
         monitor = runner.monitors[0]
     res = runner.run(quiet=quiet, on_step=ckpt)
     front_ds = monitor.dataset()

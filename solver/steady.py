@@ -19,9 +19,11 @@ nominal end, or a window that reaches that length without passing, withdraws the
 
 Signals: the equivalent front (front), the uniform depth (depth) and one equivalent front
 from each station (station): x_s + (fluid area downstream of x_s) / h_n, x_s fixed in the lab
-frame. A steady front holds every one of them; together they hold the area between the
-stations, i.e. the front's shape. (A station's depth-mean velocity is the time derivative of
-that area, q / h: the same balance, with the particles' flux noise undamped.)
+frame. A steady front holds every one of them; together they hold the areas between the
+stations, a coarse measure of the front's shape (the tip's shape within the nearest station
+they do not resolve: the case's min_time leaves out its relaxation after the start). A
+station's depth-mean velocity is the time derivative of that area, q / h: the same balance,
+with the particles' flux noise undamped.
 
 Tolerances (the probes of a coarse run fluctuate by a fraction of dp, so a tolerance fixed
 in h_n or u_b alone cannot be met at every dp):
