@@ -10,7 +10,9 @@ The first call's summed accumulators of the two are compared (round-off only). O
 line per configuration.
 
 Usage: python benchmarks/pair_loop.py OLD_TREE [--ch 1.5 1.8] [--shifting none skillen lind]
-           [--threads 2] [--calls 60]
+           [--threads 2] [--calls 60] [--physics KEY=VALUE ...]
+(--physics viscous_correction=true volume_relaxation=0.1 density_diffusion_reference=column:
+the pair loop of examples/conveyor_fast.yaml's scheme)
 """
 from __future__ import annotations
 
@@ -29,7 +31,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from throughput import layer_scene  # noqa: E402
+from throughput import layer_scene, set_physics  # noqa: E402
 
 
 def import_tree(tree: Path, name: str):
@@ -40,15 +42,15 @@ def import_tree(tree: Path, name: str):
     return importlib.import_module(name)
 
 
-def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, particles: int) -> dict:
+def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, particles: int,
+            physics=()) -> dict:
     from solver import forces
     from solver.scene import scene_from_dict
     from solver.simulation import Simulation
-    s = Simulation(scene_from_dict(layer_scene(ch, shifting, particles)))
+    s = Simulation(scene_from_dict(set_physics(layer_scene(ch, shifting, particles), physics)))
     for _ in range(warmup):
         s.step()
-    options = dict(diffusion=s.diffusion, shifting=s.shift_method != "none", shift_correction=s.correct_shift,
-                   column_reference=s.scene.physics.density_diffusion_reference == "column")
+    options = s.pair_options
     fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
                                s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume)
     loops = [(old_forces.make_pair_loop(**options), old_forces.PairFields(*fields)),
@@ -85,12 +87,15 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--calls", type=int, default=60)
     ap.add_argument("--warmup", type=int, default=20)
+    ap.add_argument("--physics", nargs="*", default=[], metavar="KEY=VALUE",
+                    help="overrides below the layer's physics, e.g. viscous_correction=true volume_relaxation=0.1")
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
     old_forces = importlib.import_module(f"{import_tree(a.old.resolve(), 'solver_old').__name__}.forces")
     for ch in a.ch:
         for shifting in a.shifting:
-            print(json.dumps(measure(old_forces, ch, shifting, a.calls, a.warmup, a.particles)), flush=True)
+            print(json.dumps({**measure(old_forces, ch, shifting, a.calls, a.warmup, a.particles, a.physics),
+                              "physics": a.physics}), flush=True)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ import time
 
 import numba
 import numpy as np
+import yaml
 
 from solver.scene import scene_from_dict
 from solver.simulation import Simulation
@@ -46,6 +47,18 @@ def layer_scene(ch: float, shifting: str, particles: int, dp: float = 1.0e-3) ->
                     "shifting": {"method": shifting}},
         "time": {"end": 1.0, "output_interval": 1.0},
     }
+
+
+def set_physics(scene: dict, items) -> dict:
+    """Apply KEY=VALUE overrides below the scene's ``physics`` (KEY dotted, VALUE in YAML)."""
+    for item in items:
+        key, value = item.split("=", 1)
+        *path, last = key.split(".")
+        node = scene.setdefault("physics", {})
+        for k in path:
+            node = node.setdefault(k, {})
+        node[last] = yaml.safe_load(value)
+    return scene
 
 
 def array_bytes(sim: Simulation) -> int:

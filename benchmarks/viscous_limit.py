@@ -30,6 +30,7 @@ import yaml
 
 from solver.scene import scene_from_dict
 from solver.simulation import Simulation
+from throughput import set_physics
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -44,14 +45,7 @@ def film(dp: float, ch: float, end: float, update: str = "explicit", physics=())
     d["walls"] = [{"name": "bed", "x": [0.0, L], "z": [-T, 0.0]}]
     d["time"] = {"end": end, "output_interval": end}
     d.setdefault("physics", {})["viscous_update"] = update
-    for item in physics:  # KEY=VALUE, KEY dotted below physics, VALUE in YAML
-        key, value = item.split("=", 1)
-        *path, last = key.split(".")
-        node = d["physics"]
-        for k in path:
-            node = node.setdefault(k, {})
-        node[last] = yaml.safe_load(value)
-    return d
+    return set_physics(d, physics)
 
 
 def exact_error(sim: Simulation) -> float:

@@ -87,13 +87,15 @@ class Simulation:
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
                                  self.variable_viscosity, self.implicit, self.strain_correction,
                                  self.volume_relaxation > 0)
-        self.pair_loop = forces.make_pair_loop(self.diffusion, shifting_on, self.correct_shift,
-                                                s.physics.density_diffusion_reference == "column",
-                                                self.viscous_correction,
-                                                bool(s.physics.artificial_viscosity),
-                                                self.variable_viscosity,
-                                                (2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
-                                                self.strain_correction, self.volume_relaxation > 0)
+        # the pair loop's compile-time switches (``forces.make_pair_loop``)
+        self.pair_options = dict(
+            diffusion=self.diffusion, shifting=shifting_on, shift_correction=self.correct_shift,
+            column_reference=s.physics.density_diffusion_reference == "column",
+            viscous_correction=self.viscous_correction, artificial=bool(s.physics.artificial_viscosity),
+            variable_viscosity=self.variable_viscosity,
+            implicit_walls=(2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
+            strain_correction=self.strain_correction, volume=self.volume_relaxation > 0)
+        self.pair_loop = forces.make_pair_loop(**self.pair_options)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
