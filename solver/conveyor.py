@@ -98,7 +98,7 @@ class ConveyorCase(YamlData):
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False
     volume_relaxation: float | None = None
-    viscous_update: str = "explicit"  # implicit: no viscous limit on dt; auto: where it pays (docs/numerics.md)
+    viscous_update: str = "explicit"  # implicit or substepped: no viscous limit on dt; auto(_substepped): where it pays
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|

@@ -223,3 +223,101 @@ def solve(ptr, cols, wts, diag, mass, kind, dt, ax, az, cx, cz, n, tol, max_iter
             ax[a] = dx[a] * inv_dt
             az[a] = dz[a] * inv_dt
     return it, math.sqrt(max(rrx / max(bbx, 1e-300), rrz / max(bbz, 1e-300)))
+
+
+# ---- sub-stepped update: Runge-Kutta-Chebyshev on the same operator -------------------------
+
+RKC_DAMPING = 0.4  # epsilon of the damped Chebyshev stability polynomial: interior |R| <= 0.70
+
+
+def rkc_stages(z: float, damping: float = RKC_DAMPING) -> int:
+    """Fewest stages s of first-order RKC whose real stability interval [-beta_s, 0] holds
+    [-z, 0], z = dt times a bound on the operator's largest eigenvalue (s = 1 is forward
+    Euler, beta about 2; beta_s grows as (2 - 4 eps / 3) s^2)."""
+    s = 1
+    while rkc_coefficients(s, damping)[0] < z:
+        s += 1
+    return s
+
+
+def rkc_coefficients(s: int, damping: float = RKC_DAMPING):
+    """(beta, mu, nu, mut) of s-stage first-order RKC (Verwer, Hundsdorfer & Sommeijer 2004):
+    w0 = 1 + eps / s^2, w1 = T_s(w0) / T_s'(w0), b_j = 1 / T_j(w0); stage j >= 2:
+    Y_j = mu_j Y_{j-1} + nu_j Y_{j-2} + (1 - mu_j - nu_j) Y_0 + mut_j dt F(Y_{j-1}),
+    mu_j = 2 w0 b_j / b_{j-1}, nu_j = -b_j / b_{j-2}, mut_j = 2 w1 b_j / b_{j-1}; stage 1:
+    Y_1 = Y_0 + mut_1 dt F(Y_0), mut_1 = w1 / w0. Its stability polynomial
+    T_s(w0 + w1 z) / T_s(w0) stays within [-1, 1] on z in [-beta, 0], beta = (1 + w0) / w1."""
+    w0 = 1.0 + damping / (s * s)
+    T = [1.0, w0]
+    U = [1.0, 2.0 * w0]  # Chebyshev polynomials of the second kind: T_j' = j U_{j-1}
+    for _ in range(2, s + 1):
+        T.append(2.0 * w0 * T[-1] - T[-2])
+        U.append(2.0 * w0 * U[-1] - U[-2])
+    w1 = T[s] / (s * U[s - 1])
+    b = [1.0 / t for t in T]
+    mu, nu, mut = np.zeros(s + 1), np.zeros(s + 1), np.zeros(s + 1)
+    mut[1] = w1 / w0
+    for j in range(2, s + 1):
+        mu[j] = 2.0 * w0 * b[j] / b[j - 1]
+        nu[j] = -b[j] / b[j - 2]
+        mut[j] = 2.0 * w1 * b[j] / b[j - 1]
+    return (1.0 + w0) / w1, mu, nu, mut
+
+
+@nb.njit(parallel=True, cache=True)
+def _largest_diagonal(diag, kind, n):
+    m = np.zeros(n)
+    for a in nb.prange(n):
+        if kind[a] == 0:
+            m[a] = diag[a]
+    return m.max() if n > 0 else 0.0
+
+
+def eigenvalue_bound(diag, kind, n: int) -> float:
+    """Gershgorin's bound on the eigenvalues of C: each row's diagonal sum_b c_ab (walls
+    twice) plus its off-diagonal sum over fluid b, at most twice the largest diagonal."""
+    return 2.0 * float(_largest_diagonal(diag, kind, n))
+
+
+@nb.njit(parallel=True, cache=True)
+def _rkc_stage(ptr, cols, wts, diag, kind, ax, az, y1x, y1z, y2x, y2z, outx, outz, mu, nu, mut_dt, n):
+    """out = mu y1 + nu y2 + mut dt (a - C y1) on the fluid rows (Y_0 = 0)."""
+    for a in nb.prange(n):
+        if kind[a] != 0:
+            outx[a] = outz[a] = 0.0
+            continue
+        sx = 0.0
+        sz = 0.0
+        for q in range(ptr[a], ptr[a + 1]):
+            b = cols[q]
+            sx += wts[q] * y1x[b]
+            sz += wts[q] * y1z[b]
+        cx = diag[a] * y1x[a] - sx
+        cz = diag[a] * y1z[a] - sz
+        outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - cx)
+        outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - cz)
+
+
+def substep(ptr, cols, wts, diag, kind, dt: float, ax, az, n: int, work) -> int:
+    """Overwrite (ax, az) of the fluid rows of [0, n) with delta / dt, delta integrating
+    d delta / dt = a - C delta from 0 over dt (the laminar term at v^n + delta, the rest at
+    the evaluation) by first-order RKC with as many stages as ``rkc_stages`` asks for dt
+    times ``eigenvalue_bound``: explicit stages, each one product with C. Returns the stages."""
+    s = rkc_stages(dt * eigenvalue_bound(diag, kind, n))
+    _, mu, nu, mut = rkc_coefficients(s)
+    ys = [(work[0], work[1]), (work[2], work[3]), (work[4], work[5])]  # Y_{j-2}, Y_{j-1}, Y_j
+    for y in ys:
+        y[0][:n] = 0.0
+        y[1][:n] = 0.0
+    fluid = kind[:n] == 0
+    # Y_1 = mut_1 dt a
+    ys[1][0][:n] = np.where(fluid, mut[1] * dt * ax[:n], 0.0)
+    ys[1][1][:n] = np.where(fluid, mut[1] * dt * az[:n], 0.0)
+    for j in range(2, s + 1):
+        (y2x, y2z), (y1x, y1z), (ox, oz) = ys
+        _rkc_stage(ptr, cols, wts, diag, kind, ax, az, y1x, y1z, y2x, y2z, ox, oz, mu[j], nu[j], mut[j] * dt, n)
+        ys = [ys[1], ys[2], ys[0]]
+    dx, dz = ys[1]
+    ax[:n] = np.where(fluid, dx[:n] / dt, ax[:n])
+    az[:n] = np.where(fluid, dz[:n] / dt, az[:n])
+    return s

@@ -70,8 +70,9 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         "threads": res.threads,
         "n_particles": res.n_particles,
         "dp": sc.dp, "h": sc.h, "c0": sc.c0, "rho0": sc.fluid.density,
-        "viscous_update": "implicit" if sc.implicit_viscosity else "explicit",
+        "viscous_update": sc.viscous_update_used,
         "cg_iterations": res.cg_iterations,
+        "rkc_stages": res.rkc_stages,
         "scene_yaml": sc.to_yaml(),
     }
     attrs.update({f"version_{k}": v for k, v in versions().items()})

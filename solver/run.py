@@ -28,6 +28,7 @@ class RunResult:
     threads: int = 1
     n_particles: int = 0
     cg_iterations: int = 0  # of the implicit viscous solves, over the steps this process ran
+    rkc_stages: int = 0  # of the sub-stepped viscous updates, over the steps this process ran
     diag_time: list = field(default_factory=list)
     diag: dict = field(default_factory=lambda: {k: [] for k in DIAGNOSTICS})
     snap_time: list = field(default_factory=list)
@@ -161,6 +162,7 @@ class Runner:
         progress(sim, force=True)
         res.steps = sim.steps
         res.cg_iterations = sim.solver_iterations
+        res.rkc_stages = sim.rkc_stages
         res.wall_time += _time.perf_counter() - tic
         return res
 

@@ -19,7 +19,7 @@ NEAR_SURFACE = ("none", "tangential")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
-VISCOUS_UPDATES = ("explicit", "implicit", "auto")
+VISCOUS_UPDATES = ("explicit", "implicit", "substepped", "auto", "auto_substepped")
 # auto: implicit where the explicit viscous step is at least this many times below the acoustic
 # one (an implicit step costs 2.7-3.5 explicit ones on the paper case at dp = 0.25 mm:
 # docs/numerics.md, "Implicit viscosity")
@@ -177,8 +177,10 @@ class Physics:
     # (solver/packing.py); null: off
     volume_relaxation: float | None = None
     # explicit (SPEC: the laminar term at v^n, dt bounded by h^2 / nu), implicit (backward
-    # Euler in the laminar term, no viscous limit on dt: solver/implicit.py) or auto (implicit
-    # where it saves steps: Scene.implicit_viscosity)
+    # Euler in the laminar term, no viscous limit on dt: solver/implicit.py), substepped (the
+    # same operator integrated over the step by explicit Runge-Kutta-Chebyshev stages, no viscous
+    # limit on dt), auto (implicit where it saves steps: Scene.implicit_viscosity) or
+    # auto_substepped (substepped there)
     viscous_update: str = "explicit"
     # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
     artificial_viscosity: float | None = None
@@ -255,16 +257,31 @@ class Scene(YamlData):
 
     @property
     def implicit_viscosity(self) -> bool:
-        """Whether the laminar term is updated implicitly: ``viscous_update: implicit``, or
-        ``auto`` where the explicit viscous step C_nu h^2 / nu is at least AUTO_IMPLICIT_RATIO
-        times below the acoustic one C h / c0 (C_nu = cfl_viscous, or cfl)."""
+        """Whether the laminar term leaves the explicit step (its operator listed by the pair
+        loop, no viscous limit on dt): ``viscous_update: implicit`` or ``substepped``, or
+        ``auto`` and ``auto_substepped`` where the explicit viscous step C_nu h^2 / nu is at
+        least AUTO_IMPLICIT_RATIO times below the acoustic one C h / c0 (C_nu = cfl_viscous,
+        or cfl)."""
         update = self.physics.viscous_update
-        if update != "auto":
-            return update == "implicit"
+        if not update.startswith("auto"):
+            return update in ("implicit", "substepped")
         from .integrate import time_step, viscous_cfl  # SPEC eq. 7's limits, at rest
         _, _, (_, dt_acoustic, dt_viscous) = time_step(self.cfl, self.h, 0.0, 0.0, self.c0, self.nu)
         c_nu = viscous_cfl(self.cfl, self.cfl_viscous)
         return self.cfl * dt_acoustic >= AUTO_IMPLICIT_RATIO * c_nu * dt_viscous
+
+    @property
+    def viscous_substeps(self) -> bool:
+        """Whether the laminar term's operator is integrated by Runge-Kutta-Chebyshev stages
+        (``solver.implicit.substep``) rather than solved by backward Euler."""
+        return self.implicit_viscosity and self.physics.viscous_update in ("substepped", "auto_substepped")
+
+    @property
+    def viscous_update_used(self) -> str:
+        """explicit, implicit or substepped: what ``viscous_update`` amounts to for this scene."""
+        if not self.implicit_viscosity:
+            return "explicit"
+        return "substepped" if self.viscous_substeps else "implicit"
 
     @property
     def shift_density_correction(self) -> bool:

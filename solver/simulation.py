@@ -101,6 +101,8 @@ class Simulation:
                               + (("gamma_p",) if self.strain_correction else ())
                               + (_IMPLICIT if self.implicit else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
+        self.substeps = s.viscous_substeps
+        self.rkc_stages = 0  # stages of the sub-stepped viscous updates, summed
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
         self.n_lattice = boundary.lattice_number_density(s.ch)
@@ -223,10 +225,17 @@ class Simulation:
 
     def _solve_viscous(self, dt: float) -> str:
         """Replace the evaluation's accelerations by (v^{n+1} - v^n) / dt of backward Euler in
-        the laminar term; the force limit of the next step takes their maximum."""
+        the laminar term (or, sub-stepped, of its RKC integration over the step); the force
+        limit of the next step takes their maximum."""
         o = self.out
         n = self.n_active
         implicit.sort_pairs(*self.pairs[:3], self.pairs.count, self.mass, n, self.rows)
+        if self.substeps:  # RKC stages instead of the backward-Euler solve
+            self.rkc_stages += implicit.substep(*self.rows[:3], o[self.nq - 1], self.kind, dt, o[forces.AX],
+                                                o[forces.AZ], n, self.solver_work)
+            fluid = self.kind[:n] == 0
+            self.amax = float(np.hypot(o[forces.AX, :n][fluid], o[forces.AZ, :n][fluid]).max(initial=0.0))
+            return ""
         it, res = implicit.solve(*self.rows[:3], o[self.nq - 1], self.mass, self.kind, dt, o[forces.AX],
                                  o[forces.AZ], self.implicit_cx, self.implicit_cz, n, implicit.TOLERANCE,
                                  implicit.MAX_ITERATIONS, self.solver_work)
