@@ -151,8 +151,8 @@ def test_a_viscosity_wrong_name_is_refused_with_its_key():
     from solver.scene import SceneError, scene_from_dict
     d = example_scene("couette").to_dict()
     d["physics"]["viscous_update"] = "crank-nicolson"
-    with pytest.raises(SceneError,
-                       match=r"physics.viscous_update: 'crank-nicolson' is not one of explicit, implicit, substepped, auto, auto_substepped"):
+    with pytest.raises(SceneError, match=r"physics.viscous_update: 'crank-nicolson' is not one of "
+                                         r"explicit, implicit, substepped, auto, auto_substepped"):
         scene_from_dict(d)
 
 
