@@ -96,12 +96,12 @@ class Simulation:
             implicit_walls=(2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
             strain_correction=self.strain_correction, volume=self.volume_relaxation > 0)
         self.pair_loop = forces.make_pair_loop(**self.pair_options)
+        self.substeps = s.viscous_substeps  # RKC stages rather than CG (no CG start to carry)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
-                              + (_IMPLICIT if self.implicit else ()))
+                              + (_IMPLICIT if self.implicit and not self.substeps else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
-        self.substeps = s.viscous_substeps
         self.rkc_stages = 0  # stages of the sub-stepped viscous updates, summed
         self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
                                                      bool(s.physics.no_penetration))
@@ -123,8 +123,9 @@ class Simulation:
         if self.implicit:
             self.rows = implicit.rows_for(self.nthreads, self.n, cap)
             self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
-        self.implicit_cx = np.zeros(self.n if self.implicit else 1)
-        self.implicit_cz = np.zeros(self.n if self.implicit else 1)
+        cg = self.implicit and not self.substeps
+        self.implicit_cx = np.zeros(self.n if cg else 1)
+        self.implicit_cz = np.zeros(self.n if cg else 1)
         self.acc = np.zeros((self.nthreads, self.n, self.nq))
         self.out = np.zeros((self.nq, self.n))
         self.vmax_t = np.zeros(self.nthreads)
