@@ -233,7 +233,7 @@ RKC_DAMPING = 0.4  # epsilon of the damped Chebyshev stability polynomial: inter
 def rkc_stages(z: float, damping: float = RKC_DAMPING) -> int:
     """Fewest stages s of first-order RKC whose real stability interval [-beta_s, 0] holds
     [-z, 0], z = dt times a bound on the operator's largest eigenvalue (s = 1 is forward
-    Euler, beta about 2; beta_s grows as (2 - 4 eps / 3) s^2)."""
+    Euler with a damping; beta_s grows as s^2, about 1.93 s^2 at eps = 0.05 and 1.6 s^2 at 0.4)."""
     s = 1
     while rkc_coefficients(s, damping)[0] < z:
         s += 1
