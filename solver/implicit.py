@@ -120,18 +120,25 @@ def sort_pairs(pair_i, pair_j, pair_k, pair_count, mass, n, rows: Rows) -> None:
     _fill_rows(pair_i, pair_j, pair_k, pair_count, mass, rows.per_thread, rows.cols, rows.wts)
 
 
+@nb.njit(inline="always", cache=True)
+def _row_sums(ptr, cols, wts, px, pz, a):
+    """Row a's off-diagonal sums (sum_b c_ab p_b) of both components."""
+    sx = 0.0
+    sz = 0.0
+    for q in range(ptr[a], ptr[a + 1]):
+        b = cols[q]
+        sx += wts[q] * px[b]
+        sz += wts[q] * pz[b]
+    return sx, sz
+
+
 @nb.njit(parallel=True, cache=True)
 def _apply(ptr, cols, wts, diag, mass, kind, dt, px, pz, yx, yz, n):
     """y = A p, A = M (I + dt C) on the fluid rows (module docstring)."""
     for a in nb.prange(n):
         if kind[a] != 0:
             continue
-        sx = 0.0
-        sz = 0.0
-        for q in range(ptr[a], ptr[a + 1]):
-            b = cols[q]
-            sx += wts[q] * px[b]
-            sz += wts[q] * pz[b]
+        sx, sz = _row_sums(ptr, cols, wts, px, pz, a)
         s = 1.0 + dt * diag[a]
         yx[a] = mass[a] * (s * px[a] - dt * sx)
         yz[a] = mass[a] * (s * pz[a] - dt * sz)
@@ -286,12 +293,7 @@ def _rkc_stage(ptr, cols, wts, diag, kind, ax, az, y1x, y1z, y2x, y2z, outx, out
         if kind[a] != 0:
             outx[a] = outz[a] = 0.0
             continue
-        sx = 0.0
-        sz = 0.0
-        for q in range(ptr[a], ptr[a + 1]):
-            b = cols[q]
-            sx += wts[q] * y1x[b]
-            sz += wts[q] * y1z[b]
+        sx, sz = _row_sums(ptr, cols, wts, y1x, y1z, a)
         cx = diag[a] * y1x[a] - sx
         cz = diag[a] * y1z[a] - sz
         outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - cx)

@@ -59,6 +59,20 @@ def rows_operator(sim, rows):
     return C
 
 
+def random_system(seed):
+    """The jittered channel's C (dense), its fluid rows, and random accelerations (ax, az) on
+    them, with the pair list arranged into the rows that the update and the solver read."""
+    sc, sim = jittered_couette()
+    C, rows, _ = dense_operator(sim)
+    rng = np.random.default_rng(seed)
+    ax = np.zeros(sim.n)
+    az = np.zeros(sim.n)
+    ax[rows] = rng.normal(0.0, 1.0, rows.size)
+    az[rows] = rng.normal(0.0, 1.0, rows.size)
+    implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, sim.n_active, sim.rows)
+    return sc, sim, C, rows, ax, az
+
+
 def test_the_pair_list_holds_every_pair_once_and_the_weighted_operator_is_symmetric():
     """m_a c_ab = m_b c_ba (the system CG needs is symmetric), every fluid pair within 2h is
     listed exactly once, and a fluid particle's diagonal exceeds its fluid weights by its
@@ -87,15 +101,8 @@ def test_the_pair_list_holds_every_pair_once_and_the_weighted_operator_is_symmet
 def test_conjugate_gradients_solve_the_backward_euler_system(dt_over_dt3):
     """(I + dt C) delta = dt a, solved by CG to a relative residual of 1e-10, against a dense
     solve of the same matrix, at a step below and far above the explicit viscous limit."""
-    sc, sim = jittered_couette()
-    C, rows, _ = dense_operator(sim)
+    sc, sim, C, rows, ax, az = random_system(2)
     dt = dt_over_dt3 * sc.h ** 2 / sc.nu
-    rng = np.random.default_rng(2)
-    ax = np.zeros(sim.n)
-    az = np.zeros(sim.n)
-    ax[rows] = rng.normal(0.0, 1.0, rows.size)
-    az[rows] = rng.normal(0.0, 1.0, rows.size)
-    implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, sim.n_active, sim.rows)
     assert np.abs(rows_operator(sim, rows) - C).max() <= 1e-14 * np.abs(C).max()  # the rows hold C
     A = np.eye(rows.size) + dt * C
     expect_x = np.linalg.solve(A, dt * ax[rows]) / dt
@@ -298,15 +305,8 @@ def test_the_substepped_update_is_runge_kutta_chebyshev_on_the_same_operator(dt_
     """implicit.substep against the dense formula of its stages on the jittered channel's C,
     below and far above the explicit viscous limit; every eigenvalue of dt C lies in the
     stages' stability interval, so no mode grows."""
-    sc, sim = jittered_couette()
-    C, rows, _ = dense_operator(sim)
+    sc, sim, C, rows, ax, az = random_system(3)
     dt = dt_over_dt3 * sc.h ** 2 / sc.nu
-    rng = np.random.default_rng(3)
-    ax = np.zeros(sim.n)
-    az = np.zeros(sim.n)
-    ax[rows] = rng.normal(0.0, 1.0, rows.size)
-    az[rows] = rng.normal(0.0, 1.0, rows.size)
-    implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, sim.n_active, sim.rows)
     expect_x, s = rkc_dense(C, dt, ax[rows])
     expect_z, _ = rkc_dense(C, dt, az[rows])
     stages = implicit.substep(*sim.rows[:3], sim.out[sim.nq - 1], sim.kind, dt, ax, az, sim.n_active,
