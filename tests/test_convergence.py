@@ -23,6 +23,23 @@ def test_non_constant_refinement_ratio():
     assert r.extrapolated == pytest.approx(2.0, abs=1e-9)
 
 
+@pytest.mark.parametrize("order", [0.3, 1.0, 2.0, 4.0])
+def test_finer_pair_refined_more(order):
+    """dp = 2, 1.75, 1.25 (r32 = 1.14, r21 = 1.4): an exact power law gives eps21 / eps32 up to
+    ln r21 / ln r32 = 2.52, above the constant-ratio bound of 1, and is still monotone."""
+    h = np.array([2.0, 1.75, 1.25])
+    r = gci(h, 0.01 + 0.02 * h ** order)
+    assert r.status == "monotone"
+    assert r.order == pytest.approx(order, rel=1e-8)
+    assert r.extrapolated == pytest.approx(0.01, abs=1e-9)
+
+
+def test_no_positive_order_fits_on_a_non_constant_ratio():
+    """dp = 2, 1.75, 1.25 and values 2.4, 2.3, 2.0: eps21 / eps32 = 3 exceeds ln r21 / ln r32,
+    the p -> 0 limit, so no power law with p > 0 passes through them."""
+    assert gci([2.0, 1.75, 1.25], [2.4, 2.3, 2.0]).status == "divergent"
+
+
 def test_oscillatory_and_divergent_are_flagged():
     h = np.array([4.0, 2.0, 1.0])
     assert gci(h, [1.2, 0.9, 1.05]).status == "oscillatory"

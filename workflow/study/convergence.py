@@ -3,11 +3,13 @@
 
 Grids h1 < h2 < h3 (fine to coarse), r21 = h2/h1, r32 = h3/h2, solutions phi1..phi3,
 eps21 = phi2 - phi1, eps32 = phi3 - phi2, s = sign(eps32/eps21), and the observed order
-from the fixed point p = |ln|eps32/eps21| + q(p)| / ln r21, q(p) = ln((r21^p - s)/(r32^p - s)).
+from eps21 / eps32 = (r21^p - 1) / (r21^p (r32^p - 1)) (Celik's fixed point with s = 1), whose
+right side falls strictly from ln r21 / ln r32 (p -> 0) to 0 (p -> inf).
 phi_ext = (r21^p phi1 - phi2)/(r21^p - 1), e_a = |(phi1 - phi2)/phi1|,
 GCI_fine = 1.25 e_a / (r21^p - 1).
-Only monotone convergence (0 < eps21/eps32 < 1) gets numbers; oscillatory (ratio < 0) and
-divergent (ratio >= 1) sequences are flagged, not forced into a number.
+Only monotone convergence (0 < eps21/eps32 < ln r21 / ln r32, which is 1 for a constant ratio)
+gets numbers; oscillatory (ratio < 0) and divergent sequences (no order p > 0 fits) are
+flagged, not forced into a number.
 """
 from __future__ import annotations
 
@@ -26,6 +28,25 @@ class GCIResult:
     error_fine: float = math.nan  # |phi1 - phi_ext| / |phi_ext|
 
 
+def observed_order(ratio: float, r21: float, r32: float) -> float:
+    """p > 0 with (r21^p - 1) / (r21^p (r32^p - 1)) = ratio, for 0 < ratio < ln r21 / ln r32
+    (bisection on a strictly decreasing function)."""
+    def f(p):
+        return (1.0 - r21 ** -p) / (r32 ** p - 1.0) - ratio
+    lo, hi = 1e-9, 1.0
+    while f(hi) > 0:
+        lo, hi = hi, 2.0 * hi
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if f(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-14 * hi:
+            break
+    return 0.5 * (lo + hi)
+
+
 def gci(h, phi, safety: float = 1.25) -> GCIResult:
     """Three (or more: the three finest are used) resolutions h and solutions phi."""
     h = np.asarray(h, dtype=float)
@@ -42,18 +63,10 @@ def gci(h, phi, safety: float = 1.25) -> GCIResult:
     ratio = e21 / e32
     if ratio < 0:
         return GCIResult("oscillatory")
-    if ratio >= 1:
-        return GCIResult("divergent")
     r21, r32 = h2 / h1, h3 / h2
-    s = math.copysign(1.0, e32 / e21)
-    p = abs(math.log(abs(e32 / e21))) / math.log(r21)
-    for _ in range(200):
-        q = math.log((r21 ** p - s) / (r32 ** p - s))
-        p_new = abs(math.log(abs(e32 / e21)) + q) / math.log(r21)
-        if abs(p_new - p) < 1e-12:
-            p = p_new
-            break
-        p = p_new
+    if ratio >= math.log(r21) / math.log(r32):
+        return GCIResult("divergent")
+    p = observed_order(ratio, r21, r32)
     ext = (r21 ** p * f1 - f2) / (r21 ** p - 1)
     ea = abs((f1 - f2) / f1) if f1 != 0 else math.nan
     return GCIResult("monotone", p, ext, safety * ea / (r21 ** p - 1),
