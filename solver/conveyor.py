@@ -41,8 +41,9 @@ class Steady:
     depth: float = 0.005  # uniform-depth change over the window / h_n
     average: float = 2.0  # s: averaging window once steady
     max_time: float = 30.0  # s: give up (status not_steady) after this
-    min_time: float = 2.0  # s after the end of the belt ramp before steadiness counts: the start's
-    # transient, the tip relaxing to the scheme's own shape (2.5-3 s at dp = 1 mm, docs/conveyor.md)
+    min_time: float = 4.0  # s after the end of the belt ramp before steadiness counts: the start's
+    # transient, which the detection's signals do not see (measured to end by 3-3.5 s at dp = 0.5
+    # and 1 mm and by 5-6 s at dp = 1.5-2.25 mm: docs/conveyor.md, "The start's transient and min_time")
     stop: bool = True  # false: run to max_time and average its final window (fixed end time)
 
 
