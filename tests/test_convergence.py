@@ -46,6 +46,7 @@ def test_oscillatory_and_divergent_are_flagged():
     assert np.isnan(gci(h, [1.2, 0.9, 1.05]).order)
     assert gci(h, [1.0, 1.1, 1.5]).status == "divergent"
     assert gci(h[:2], [1.0, 1.1]).status == "insufficient"
+    assert gci([2.0, 1.0, 1.0], [1.3, 1.1, 1.0]).status == "insufficient"  # one resolution twice
 
 
 def test_pareto_front_and_cheapest():

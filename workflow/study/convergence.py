@@ -2,9 +2,10 @@
 (Roache; Celik et al. 2008, J. Fluids Eng. 130:078001) for three resolutions.
 
 Grids h1 < h2 < h3 (fine to coarse), r21 = h2/h1, r32 = h3/h2, solutions phi1..phi3,
-eps21 = phi2 - phi1, eps32 = phi3 - phi2, s = sign(eps32/eps21), and the observed order
-from eps21 / eps32 = (r21^p - 1) / (r21^p (r32^p - 1)) (Celik's fixed point with s = 1), whose
-right side falls strictly from ln r21 / ln r32 (p -> 0) to 0 (p -> inf).
+eps21 = phi2 - phi1, eps32 = phi3 - phi2, and the observed order p > 0 of a monotone
+sequence from eps21 / eps32 = (r21^p - 1) / (r21^p (r32^p - 1)) (Celik's relation for
+s = sign(eps32 / eps21) = 1), whose right side falls strictly from ln r21 / ln r32 (p -> 0)
+to 0 (p -> inf).
 phi_ext = (r21^p phi1 - phi2)/(r21^p - 1), e_a = |(phi1 - phi2)/phi1|,
 GCI_fine = 1.25 e_a / (r21^p - 1).
 Only monotone convergence (0 < eps21/eps32 < ln r21 / ln r32, which is 1 for a constant ratio)
@@ -57,13 +58,15 @@ def gci(h, phi, safety: float = 1.25) -> GCIResult:
         return GCIResult("insufficient")
     order = np.argsort(h)[:3]
     (h1, h2, h3), (f1, f2, f3) = h[order], phi[order]
+    r21, r32 = h2 / h1, h3 / h2
+    if not (r21 > 1.0 and r32 > 1.0):  # two runs at the same resolution
+        return GCIResult("insufficient")
     e21, e32 = f2 - f1, f3 - f2
     if e32 == 0 or e21 == 0:
         return GCIResult("insufficient" if e21 == e32 == 0 else "divergent")
     ratio = e21 / e32
     if ratio < 0:
         return GCIResult("oscillatory")
-    r21, r32 = h2 / h1, h3 / h2
     if ratio >= math.log(r21) / math.log(r32):
         return GCIResult("divergent")
     p = observed_order(ratio, r21, r32)
