@@ -23,7 +23,7 @@ def test_the_report_opens_with_the_verdict():
     assert "dp for 1 %" in text and "mm</td>" in text  # the dp needed, in mm
 
 
-def test_the_case_table_gives_zeta_f_with_its_sampling_error():
+def test_the_case_table_gives_the_metrics_with_their_sampling_error():
     """zeta_f is shown as value +- 2 se where the run carries its standard error, alone where
     it does not (metrics written before the error was kept)."""
     from study.report import case_table
@@ -34,6 +34,11 @@ def test_the_case_table_gives_zeta_f_with_its_sampling_error():
     table = case_table(ds)
     assert table.count("0.0077 &plusmn; 0.021") == ds.sizes["case"] - 1
     assert "zeta_f (± 2 se)" in table
+    # zeta_u's jackknife error, in plain decimals to two digits
+    ds["case_zeta_u"][:] = 0.0159
+    ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], 0.00029)
+    table = case_table(ds)
+    assert table.count("0.0159 &plusmn; 0.00058") == ds.sizes["case"] * ds.sizes["station"]
 
 
 def test_a_yield_stress_campaign_is_not_judged_against_the_newtonian_paper():

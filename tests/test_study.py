@@ -11,7 +11,7 @@ import yaml
 
 from study import config as cfgmod
 from study.grid import CASE_ID, case_id, expand, fmt
-from study.metrics import case_metrics, rms_difference, zeta_f_error
+from study.metrics import JACKKNIFE_BLOCKS, case_metrics, rms_difference, zeta_f_error
 from study.reference import read_velocity_csv, theory
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -166,6 +166,79 @@ def test_metrics_nan_for_diverged_run():
     run, ref = synthetic_run(status="diverged")
     m = case_metrics(run, ref)
     assert np.isnan(float(m.zeta_f)) and np.all(np.isnan(m.zeta_u.values))
+
+
+def series_run(depth_noise=0.0, u_noise=0.0, depth_ramp=0.0, seed=0, n=51, window=1.0):
+    """A run with a probe record whose last ``window`` s is its averaging window: the theory's
+    surface, the depth h_n (1 + 0.02 + depth_ramp t / window + noise) and u* = (1.1 + noise)
+    u*_ref; white noise of the given standard deviations, one draw per sample."""
+    rng = np.random.default_rng(seed)
+    hn, ub = 0.01876, 0.075
+    x = np.round(np.arange(0, 14.0001, 0.1), 10)
+    z = np.round(np.arange(0, 1.3001, 0.025), 10)
+    st = np.array([0.76, 1.5, 9.7])
+    ref = theory(x, st, z, 15.3)
+    t = np.linspace(2.0, 2.0 + window, n)
+    depth = hn * (1.02 + depth_ramp * (t - t[0]) / window + depth_noise * rng.standard_normal(n))
+    scale = 1.1 + u_noise * rng.standard_normal(n)
+    run = xr.Dataset(
+        {"uniform_depth": ("time", depth),
+         "surface_elevation": (("time", "x_star"), np.tile(ref["surface"].values * hn, (n, 1))),
+         "velocity_star": (("time", "station", "z_star"), scale[:, None, None] * ref["velocity"].values[None]),
+         "front_velocity": ((), 0.0)},
+        coords={"time": t, "x_star": x, "station": st, "z_star": z},
+        attrs={"status": "completed", "h_n_m": hn, "belt_speed_m_s": ub, "normalising_depth_m": 0.0186,
+               "average_window_s": float(t[-1] - t[0])})
+    for k in ("uniform_depth", "surface_elevation", "velocity_star"):
+        run[f"mean_{k}"] = run[k].mean("time")
+    return run, theory(np.round(np.arange(0, 12.0001, 0.1), 10), st, z, 15.3)
+
+
+def test_window_errors_recover_white_noise():
+    """zeta_u's jackknife se is the standard error of the window mean, sigma / sqrt(n) times
+    the RMS of u*_ref over the heights, averaged over 200 records within 10 % (the jackknife's
+    own scatter with 5 blocks is about 35 % a record). zeta_h's adds half the fitted change of
+    a depth that does not drift: sigma / sqrt(n) sqrt(3 (n - 1) / (n + 1)) |Z| for a normal Z,
+    so its mean is E sqrt(1 + 3 (n - 1) / (n + 1) Z^2) sigma / sqrt(n), within 10 %."""
+    n, sd_h, sd_u = 51, 0.004, 0.01
+    se_h, se_u = [], []
+    for seed in range(200):
+        run, ref = series_run(depth_noise=sd_h, u_noise=sd_u, seed=seed, n=n)
+        m = case_metrics(run, ref)
+        se_h.append(float(m.zeta_h_se))
+        se_u.append(m.zeta_u_se.values)
+    z = np.linspace(-8.0, 8.0, 20001)
+    factor = np.trapezoid(np.sqrt(1 + 3 * (n - 1) / (n + 1) * z ** 2) * np.exp(-z * z / 2), z) / math.sqrt(2 * math.pi)
+    assert np.mean(se_h) == pytest.approx(factor * sd_h / math.sqrt(n), rel=0.10)
+    u = ref["velocity"].sel(station=9.7).values
+    rms_u = math.sqrt(np.nanmean(u ** 2))
+    assert np.mean(se_u, axis=0)[2] == pytest.approx(sd_u / math.sqrt(n) * rms_u, rel=0.10)
+    # a noiseless record has no sampling error
+    m = case_metrics(*series_run())
+    assert float(m.zeta_h_se) < 1e-12 and float(m.zeta_fs_se) < 1e-12 and np.all(m.zeta_u_se.values < 1e-12)
+
+
+def test_window_errors_carry_the_depth_drift():
+    """A depth ramping by 1 % h_n through the window: zeta_h's se holds half the change,
+    0.5 %, with the ramp's jackknife scatter sqrt((B + 1) / 12) / B of the change on top."""
+    run, ref = series_run(depth_ramp=0.01)
+    m = case_metrics(run, ref)
+    jack = 0.01 * math.sqrt((JACKKNIFE_BLOCKS + 1) / 12) / JACKKNIFE_BLOCKS
+    assert float(m.zeta_h_se) == pytest.approx(math.hypot(0.005, jack), rel=0.02)
+    assert float(m.zeta_h) == pytest.approx(0.025, rel=1e-9)  # the window mean: 1.02 + 0.005
+
+
+def test_window_errors_unknown_without_a_matching_record():
+    """No record, too short a window, or a record whose window mean is not the stored one:
+    the errors are NaN (unknown), never zero."""
+    run, ref = series_run(n=9)  # fewer than 2 samples a block
+    assert np.isnan(float(case_metrics(run, ref).zeta_fs_se))
+    run, ref = series_run(depth_noise=0.004)
+    run["mean_uniform_depth"] = run["mean_uniform_depth"] * 1.001
+    m = case_metrics(run, ref)
+    assert np.isnan(float(m.zeta_h_se)) and np.all(np.isnan(m.zeta_u_se.values))
+    run, ref = synthetic_run()
+    assert np.isnan(float(case_metrics(run, ref).zeta_h_se))
 
 
 def test_measured_csv(tmp_path):

@@ -174,3 +174,38 @@ def test_a_zeta_f_whose_sampling_error_is_unknown_decides_nothing():
     ds = campaign(opposite)
     ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], np.nan)
     assert by_claim(ds)["zeta_f"].verdict == "not reproduced"  # contradicted with se = 0
+
+
+def test_a_zeta_u_difference_within_its_sampling_error_does_not_contradict():
+    """The opposite campaign: lind's zeta_u is 3x skillen's, at dp = 1 mm 0.036 / 0.096 / 0.126
+    against 0.012 / 0.032 / 0.042 (differences 0.024 / 0.064 / 0.084). With se = 0.001 a run
+    the marginal claim is contradicted and its evidence shows the 2 se of the difference; with
+    se = 0.03 (2 se of a difference 0.085) no difference exceeds 1 % of u_b by more than 2 se:
+    not reproduced; nor with an unknown se."""
+    ds = campaign(opposite)
+    ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], 0.001)
+    v = by_claim(ds)["marginal"]
+    assert v.verdict == "contradicted"
+    assert "x* = 9.7: lind 0.126, skillen 0.042 (difference 0.084 ± 0.003, 2 se)" in v.evidence
+    for se in (0.03, np.nan):
+        ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], se)
+        assert by_claim(ds)["marginal"].verdict == "not reproduced"
+    ds = campaign(paper_like)  # differences of 0.002: marginal whatever their se
+    ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], np.nan)
+    assert by_claim(ds)["marginal"].verdict == "reproduced"
+
+
+def test_the_cheapest_run_under_a_threshold_honours_zeta_u_sampling_error():
+    """zeta_u(9.7) of the paper-like campaign is 0.012-0.014 at dp = 1 mm and 0.018-0.020 at
+    4 mm: with 2 se = 0.002 the cheapest run under 5 % is at dp = 4 mm; with 2 se = 0.04 none
+    is below 5 %, nor with an unknown se."""
+    from study.verdict import accuracy_rows
+    ds = campaign(paper_like)
+    ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], 0.001)
+    row = next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_u (x* = 9.7)")
+    case, _, value, two_se = row["cheapest"][0.05]
+    assert case.startswith("dp4mm") and two_se == pytest.approx(0.002) and value + two_se < 0.05
+    for se in (0.02, np.nan):
+        ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], se)
+        row = next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_u (x* = 9.7)")
+        assert row["cheapest"][0.05] is None

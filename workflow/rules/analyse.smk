@@ -5,6 +5,7 @@ rule metrics:
         "results/cases/{case}/metrics.nc",
     params:
         settings=lambda wc: yaml.safe_dump({k: config[k] for k in ("reference", "metrics")}),
+        code=METRICS_HASH,
         config=CONFIG_FILE,
     log:
         "results/logs/metrics_{case}.log",

@@ -31,6 +31,17 @@ from solver.sources import source_hash
 
 SOLVER_HASH = source_hash()  # a param of every run: a changed solver reruns them
 
+
+def _code_hash(*modules):
+    import hashlib
+    from pathlib import Path
+    return hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in modules)).hexdigest()[:16]
+
+
+import study.metrics, study.reference
+
+METRICS_HASH = _code_hash(study.metrics, study.reference)  # a param of the metrics: new metric code rescores
+
 wildcard_constraints:
     case=CASE_ID,
 

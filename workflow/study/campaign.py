@@ -9,7 +9,9 @@ import xarray as xr
 from . import stability
 from .grid import Case
 
-SCALARS = ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_fs_measured")
+SCALARS = ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_se", "zeta_h_paper", "zeta_h_paper_se", "zeta_fs",
+           "zeta_fs_se", "zeta_fs_measured")
+STATION_METRICS = ("zeta_u", "zeta_u_se", "zeta_u_measured")
 RUN_NUMBERS = {
     "wall_time": ("wall_time_s", "s", "wall-clock time of the run"),
     "steps": ("steps", "1", "time steps"),
@@ -60,8 +62,8 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     shape = (len(dps), len(chs), len(shs))
     arr = lambda *extra: np.full(shape + extra, np.nan)  # noqa: E731
     data = {k: arr() for k in SCALARS}
-    data["zeta_u"] = arr(stations.size)
-    data["zeta_u_measured"] = arr(stations.size)
+    for k in STATION_METRICS:
+        data[k] = arr(stations.size)
     for k in RUN_NUMBERS:
         data[k] = arr()
     data["uniform_depth"] = arr()
@@ -81,9 +83,9 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
             continue
         ix = (dps.index(c.dp), chs.index(c.ch), shs.index(c.shifting))
         for k in SCALARS:
-            data[k][ix] = float(m[k]) if k in m else np.nan  # metrics written before zeta_f_se
-        data["zeta_u"][ix] = m["zeta_u"].values
-        data["zeta_u_measured"][ix] = m["zeta_u_measured"].values
+            data[k][ix] = float(m[k]) if k in m else np.nan  # metrics written before their se
+        for k in STATION_METRICS:
+            data[k][ix] = m[k].values if k in m else np.nan
         for k, (attr, _, _) in RUN_NUMBERS.items():
             data[k][ix] = float(run.attrs.get(attr, np.nan))
         if "mean_surface_elevation" in run and run.attrs["status"] != "diverged":
@@ -99,8 +101,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     dims = ("dp", "ch", "shifting")
     ds = xr.Dataset(
         {**{k: (dims, data[k]) for k in SCALARS + tuple(RUN_NUMBERS)},
-         "zeta_u": (dims + ("station",), data["zeta_u"]),
-         "zeta_u_measured": (dims + ("station",), data["zeta_u_measured"]),
+         **{k: (dims + ("station",), data[k]) for k in STATION_METRICS},
          "uniform_depth": (dims, data["uniform_depth"], {"units": "1", "long_name": "uniform depth h_u / h_n"}),
          "mean_surface": (dims + ("x_star",), data["mean_surface"]),
          "mean_velocity": (dims + ("station", "z_star"), data["mean_velocity"]),
@@ -119,8 +120,8 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
                 "x_star": ("x_star", x_star, {"units": "1"}), "z_star": ("z_star", z_star, {"units": "1"})})
     for k in SCALARS:
         ds[k].attrs.update(metrics[0][k].attrs if k in metrics[0] else {})
-    for k in ("zeta_u", "zeta_u_measured"):
-        ds[k].attrs.update(metrics[0][k].attrs)
+    for k in STATION_METRICS:
+        ds[k].attrs.update(metrics[0][k].attrs if k in metrics[0] else {})
     for k, (_, units, long) in RUN_NUMBERS.items():
         ds[k].attrs.update(units=units, long_name=long)
     ds["mean_surface"].attrs.update(units="1", long_name="steady free surface h/h_n")
@@ -144,7 +145,9 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
         ds[f"case_{k}"] = ("case", [float(r.attrs.get(attr, np.nan)) for r in runs], {"units": units})
     for k in SCALARS:
         ds[f"case_{k}"] = ("case", [float(m[k]) if k in m else np.nan for m in metrics])
-    ds["case_zeta_u"] = (("case", "station"), np.stack([m["zeta_u"].values for m in metrics]))
+    for k in ("zeta_u", "zeta_u_se"):
+        ds[f"case_{k}"] = (("case", "station"), np.stack([m[k].values if k in m else np.full(stations.size, np.nan)
+                                                         for m in metrics]))
     # stability: margins to each guard, the detector that fired, the swept settings
     marg = [stability.margins(r) for r in runs]
     for k, long in (("density_margin", "max density deviation / its guard"),

@@ -3,6 +3,17 @@
 x* is measured upslope from the toe in units of the computed normal depth h_n, depths
 are h/h_n, velocities u* = (u + u_b)/u_b in the belt frame; all from the steady-window
 means of a run (``mean_*`` variables of the per-run NetCDF).
+
+Sampling errors: zeta_f's from the toe's scatter (``zeta_f_error``); zeta_h's, zeta_fs's and
+zeta_u's by a block jackknife over the averaging window (``window_errors``): the window's
+samples in JACKKNIFE_BLOCKS contiguous blocks, each metric recomputed from the means with one
+block left out, se^2 = (B - 1)/B sum_k (zeta_(k) - mean_k zeta_(k))^2. That measures the
+scatter of the window mean, not a drift: the uniform depth drifts slowly, so zeta_h's se adds
+half the depth's least-squares change through the window T, se_h^2 = se_jack^2 +
+(|dh/dt| T / (2 h_ref))^2. A drifting depth has no single steady value; the window's mean is
+within that of the depth at both its ends. On a depth that does not drift, the fitted slope's
+own noise makes zeta_h's se larger than the window mean's, by a factor of 1.7 on average for
+white noise (tests/test_study.py): conservative.
 """
 from __future__ import annotations
 
@@ -63,6 +74,69 @@ def zeta_u(ref_velocity: xr.DataArray, num_velocity: xr.DataArray) -> float:
     return rms_difference(ref_velocity, num_velocity, "z_star")
 
 
+JACKKNIFE_BLOCKS = 5
+MIN_BLOCK_SAMPLES = 2  # fewer samples a block: the window's errors are not measured (NaN)
+PROFILE_METRICS = ("zeta_h", "zeta_h_paper", "zeta_fs")
+
+
+def profile_metrics(depth: float, surface: xr.DataArray, velocity: xr.DataArray, run: xr.Dataset,
+                    ref: xr.Dataset, x_star_range=(0.0, 12.0)) -> tuple[dict, np.ndarray]:
+    """zeta_h, zeta_h_paper, zeta_fs and zeta_u (per reference station) of one set of means:
+    the uniform depth [m], the surface elevation (x_star) [m] and u* (station, z_star)."""
+    hn = float(run.attrs["h_n_m"])
+    lo, hi = x_star_range
+    out = {"zeta_h": zeta_h(depth, hn),
+           "zeta_h_paper": zeta_h(depth, float(run.attrs["normalising_depth_m"])),
+           "zeta_fs": zeta_fs(ref["surface"].sel(x_star=slice(lo, hi)), surface / hn)}
+    zu = np.array([zeta_u(ref["velocity"].sel(station=s), velocity.sel(station=s, method="nearest"))
+                   for s in ref["station"].values])
+    return out, zu
+
+
+def window_samples(run: xr.Dataset) -> np.ndarray | None:
+    """Indices of the time samples the run's ``mean_*`` were taken over: its record's final
+    ``average_window_s`` (a run ends with its averaging window). None where the record lacks
+    them or their mean does not reproduce the stored ``mean_uniform_depth``."""
+    if "uniform_depth" not in run or "average_window_s" not in run.attrs or run.sizes.get("time", 0) == 0:
+        return None
+    t = run["time"].values
+    idx = np.flatnonzero(t >= t[-1] - float(run.attrs["average_window_s"]) - 1e-9)
+    depth = run["uniform_depth"].values[idx]
+    if not np.isclose(np.nanmean(depth), float(run["mean_uniform_depth"]), rtol=1e-9, atol=0.0):
+        return None
+    return idx
+
+
+def jackknife_se(leave_one_out: np.ndarray) -> np.ndarray:
+    """Jackknife standard error from the B leave-one-block-out estimates (axis 0)."""
+    b = leave_one_out.shape[0]
+    return np.sqrt((b - 1) / b * ((leave_one_out - leave_one_out.mean(axis=0)) ** 2).sum(axis=0))
+
+
+def window_errors(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, x_star_range=(0.0, 12.0),
+                  blocks: int = JACKKNIFE_BLOCKS) -> tuple[dict, np.ndarray]:
+    """Block-jackknife standard errors of zeta_h, zeta_h_paper, zeta_fs and zeta_u (per
+    station) over the time samples ``idx`` (contiguous), zeta_h's with the depth's drift
+    (module docstring): NaN where a block would hold fewer than MIN_BLOCK_SAMPLES."""
+    nan = ({k: np.nan for k in PROFILE_METRICS}, np.full(ref["station"].size, np.nan))
+    if idx.size < blocks * MIN_BLOCK_SAMPLES:
+        return nan
+    scalars, zus = [], []
+    for drop in np.array_split(idx, blocks):
+        keep = run.isel(time=np.setdiff1d(idx, drop))
+        s, zu = profile_metrics(float(keep["uniform_depth"].mean("time")), keep["surface_elevation"].mean("time"),
+                                keep["velocity_star"].mean("time"), run, ref, x_star_range)
+        scalars.append([s[k] for k in PROFILE_METRICS])
+        zus.append(zu)
+    se = dict(zip(PROFILE_METRICS, jackknife_se(np.array(scalars))))
+    from solver.steady import trend
+    t = run["time"].values[idx]
+    half_change = 0.5 * abs(trend(t, run["uniform_depth"].values[idx])) * (t[-1] - t[0])
+    for k, h_ref in (("zeta_h", run.attrs["h_n_m"]), ("zeta_h_paper", run.attrs["normalising_depth_m"])):
+        se[k] = float(np.hypot(se[k], half_change / float(h_ref)))
+    return se, jackknife_se(np.array(zus))
+
+
 def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
                  measured: dict | None = None) -> xr.Dataset:
     """All metrics of one run against the reference (and measured data when given).
@@ -71,8 +145,8 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     over its final window, flagged by ``steady = 0`` (the report and figures mark them).
     """
     st = ref["station"].values
-    out = {k: np.nan for k in ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_paper", "zeta_fs")}
-    zu = np.full(st.size, np.nan)
+    out = {k: np.nan for k in ("zeta_f", "zeta_f_se") + PROFILE_METRICS + tuple(f"{k}_se" for k in PROFILE_METRICS)}
+    zu, zu_se = np.full(st.size, np.nan), np.full(st.size, np.nan)
     meas = {"zeta_fs_measured": np.nan}
     zu_meas = np.full(st.size, np.nan)
     ok = run.attrs.get("status") in ("completed", "not_steady") and "mean_surface_elevation" in run
@@ -82,25 +156,24 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         out["zeta_f"] = zeta_f(float(run["front_velocity"]), ub)
         if "toe_position" in run:  # the probe record (absent from hand-made means-only runs)
             out["zeta_f_se"] = zeta_f_error(run["time"].values, run["toe_position"].values, ub)
-        depth = float(run["mean_uniform_depth"])
-        out["zeta_h"] = zeta_h(depth, hn)
-        out["zeta_h_paper"] = zeta_h(depth, float(run.attrs["normalising_depth_m"]))
-        surf = run["mean_surface_elevation"] / hn
-        lo, hi = x_star_range
-        rs = ref["surface"].sel(x_star=slice(lo, hi))
-        out["zeta_fs"] = zeta_fs(rs, surf)
+        surf = run["mean_surface_elevation"]
         vel = run["mean_velocity_star"]
-        for j, s in enumerate(st):
-            zu[j] = zeta_u(ref["velocity"].sel(station=s), vel.sel(station=s, method="nearest"))
+        scalars, zu = profile_metrics(float(run["mean_uniform_depth"]), surf, vel, run, ref, x_star_range)
+        out.update(scalars)
+        idx = window_samples(run)
+        if idx is not None:
+            se, zu_se = window_errors(run, ref, idx, x_star_range)
+            out.update({f"{k}_se": v for k, v in se.items()})
         if measured:
             if measured.get("surface") is not None:
-                meas["zeta_fs_measured"] = zeta_fs(measured["surface"], surf)
+                meas["zeta_fs_measured"] = zeta_fs(measured["surface"], surf / hn)
             for j, s in enumerate(st):
                 m = (measured.get("velocity") or {}).get(float(s))
                 if m is not None:
                     zu_meas[j] = zeta_u(m, vel.sel(station=s, method="nearest"))
     data = {k: ((), v) for k, v in {**out, **meas}.items()}
     data["zeta_u"] = (("station",), zu)
+    data["zeta_u_se"] = (("station",), zu_se)
     data["zeta_u_measured"] = (("station",), zu_meas)
     data["steady"] = ((), int(run.attrs.get("steady", 0)) if ok else 0)
     ds = xr.Dataset(data, coords={"station": st})
@@ -112,6 +185,10 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         "zeta_h_paper": "uniform depth error against the paper's normalising depth",
         "zeta_fs": "free-surface RMS error against the theory",
         "zeta_u": "velocity-profile RMS error against the theory",
+        "zeta_h_se": "standard error of zeta_h over the averaging window (block jackknife)",
+        "zeta_h_paper_se": "standard error of zeta_h_paper over the averaging window (block jackknife)",
+        "zeta_fs_se": "standard error of zeta_fs over the averaging window (block jackknife)",
+        "zeta_u_se": "standard error of zeta_u over the averaging window (block jackknife)",
         "zeta_fs_measured": "free-surface RMS error against measured data",
         "zeta_u_measured": "velocity-profile RMS error against measured data",
     }

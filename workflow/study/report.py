@@ -50,16 +50,18 @@ def _commit() -> str:
 
 
 def _with_error(value, se) -> str:
-    """value +- 2 se (the sampling error of zeta_f), or the value alone where se is unknown."""
-    if se is None or not np.isfinite(se):
+    """value +- 2 se (its sampling error), or the value alone where se is unknown."""
+    if se is None or not np.isfinite(se) or not np.isfinite(value):
         return _fmt(value)
-    return f"{_fmt(value)} &plusmn; {_fmt(2.0 * se)}"
+    two_se = np.format_float_positional(2.0 * se, precision=2, unique=False, fractional=False, trim="-")
+    return f"{_fmt(value)} &plusmn; {two_se}"
 
 
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
     head = ["case", "status", "steady", "wall time [s]", "steps", "particles", "steady at [s]",
-            "zeta_f (± 2 se)", "zeta_h (h_n)", "zeta_h (paper)", "zeta_fs"] + [f"zeta_u x*={s:g}" for s in st]
+            "zeta_f (± 2 se)", "zeta_h (h_n, ± 2 se)", "zeta_h (paper)", "zeta_fs (± 2 se)"] + [
+                f"zeta_u x*={s:g} (± 2 se)" for s in st]
     rows = []
     for i, cid in enumerate(ds["case"].values):
         status = str(ds["case_status"].values[i])
@@ -70,12 +72,12 @@ def case_table(ds: xr.Dataset) -> str:
                  f'<td>{"yes" if int(ds["case_steady"].values[i]) else "no"}</td>']
         for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time"):
             cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
-        se = ds["case_zeta_f_se"].values[i] if "case_zeta_f_se" in ds else None
-        cells.append(f"<td>{_with_error(ds['case_zeta_f'].values[i], se)}</td>")
-        for k in ("case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
-            cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
+        for k in ("case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
+            se = ds[f"{k}_se"].values[i] if f"{k}_se" in ds and k != "case_zeta_h_paper" else None
+            cells.append(f"<td>{_with_error(ds[k].values[i], se)}</td>")
         for j in range(st.size):
-            cells.append(f"<td>{_fmt(ds['case_zeta_u'].values[i, j])}</td>")
+            se = ds["case_zeta_u_se"].values[i, j] if "case_zeta_u_se" in ds else None
+            cells.append(f"<td>{_with_error(ds['case_zeta_u'].values[i, j], se)}</td>")
         rows.append(f'<tr class="{html.escape(status)}">' + "".join(cells) + "</tr>")
     th = "".join(f'<th class="{"l" if k < 2 else ""}">{html.escape(h)}</th>' for k, h in enumerate(head))
     return f"<table><tr>{th}</tr>{''.join(rows)}</table>"
@@ -171,7 +173,7 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
             + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
             "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
     return ("<p>The cheapest steady run (wall time, error) meeting each threshold over the whole "
-            "grid (zeta_f, with its sampling error: below by more than 2 se); then, at the paper's "
+            "grid (with its sampling error: below by more than 2 se); then, at the paper's "
             "Ch, the metric at the finest dp, its Richardson limit with the GCI band of the finest "
             "value (Celik et al. 2008; only for monotone sequences over the three finest dp) and "
             "the dp at which zeta = limit + C dp^p reaches 1 % (not projected from an observed "
@@ -237,7 +239,12 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "have no metrics. "
                f"zeta_h is given against the computed normal depth h_n = "
                f"{_fmt(ds.attrs.get('h_n_m', np.nan) * 1000, 4)} mm and against the paper's "
-               f"normalising depth {_fmt(ds.attrs.get('normalising_depth_m', np.nan) * 1000, 4)} mm.</p>")
+               f"normalising depth {_fmt(ds.attrs.get('normalising_depth_m', np.nan) * 1000, 4)} mm. "
+               "&plusmn; 2 se: the sampling error of a run's window (zeta_f: from the toe's scatter; "
+               "zeta_h, zeta_fs, zeta_u: a block jackknife over the window, zeta_h's with half the "
+               "depth's drift through it). It is not the discretisation error, and the verdicts and "
+               "the cheapest runs use it: a value is below a threshold only by more than 2 se, two "
+               "runs within 2 se tie.</p>")
     figs = []
     for path, title, caption in figures:
         data = base64.b64encode(Path(path).read_bytes()).decode()

@@ -11,10 +11,11 @@ Verdicts:
   the extrapolation does not rule the threshold out);
 - ``no data``: the runs the claim needs are missing or diverged.
 A verdict whose evidence includes runs that were not steady says so (``unsteady``).
-A metric with a sampling error in the campaign dataset (``zeta_f_se``) is below or above a
-threshold only by more than 2 se, and two runs within 2 se of each other tie; a run whose
-sampling error could not be measured (NaN: too few toe samples) is neither below nor above,
-and ties.
+A metric with a sampling error in the campaign dataset (``{var}_se``: zeta_f from the toe's
+scatter; zeta_h, zeta_fs and zeta_u per station by the block jackknife of study.metrics) is
+below or above a threshold only by more than 2 se, and two runs within 2 se of each other
+tie; a run whose sampling error could not be measured (NaN: too few samples) is neither below
+nor above, and ties.
 """
 from __future__ import annotations
 
@@ -134,13 +135,13 @@ def _mm(dp):
     return f"{dp * 1000:g} mm"
 
 
-def _se(ds, var, dp, ch, sh) -> float:
-    """The sampling standard error of ``var`` at one run (``{var}_se`` in the campaign
-    dataset): 0 where the campaign has no such variable, NaN where the run's could not be
-    measured."""
+def _se(ds, var, dp, ch, sh, station=None) -> float:
+    """The sampling standard error of ``var`` at one run (and station) (``{var}_se`` in the
+    campaign dataset): 0 where the campaign has no such variable, NaN where the run's could
+    not be measured."""
     if f"{var}_se" not in ds:
         return 0.0
-    return float(ds[f"{var}_se"].sel(dp=dp, ch=ch, shifting=sh))
+    return float(_series(ds, f"{var}_se", ch, sh, station).sel(dp=dp))
 
 
 def threshold_claim(ds, var, threshold, chs, sh, need, claim):
@@ -285,9 +286,11 @@ def lind_better_claim(ds, claim):
             word, better = "lind better", better + 1
         else:
             word, worse = "skillen better", worse + 1
-        parts.append(f"{var}: lind {_pct(lv)}, skillen {_pct(sv)} ({word})")
+        lse, sse = (_se(ds, var, dp, ch, s) for s in ("lind", "skillen"))
+        err = lambda se: f" ± {_pct(2 * se)}" if np.isfinite(se) and se > 0 else ""  # noqa: E731
+        parts.append(f"{var}: lind {_pct(lv)}{err(lse)}, skillen {_pct(sv)}{err(sse)} ({word})")
     verdict = "reproduced" if better == 2 else "contradicted" if worse == 2 else "not reproduced"
-    evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts)
+    evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts) + (" (± 2 se)" if "±" in "".join(parts) else "")
     sels = [dict(dp=dp, ch=ch, shifting=s) for s in ("lind", "skillen")]
     return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
 
@@ -296,7 +299,8 @@ def marginal_shifting_claim(ds, claim):
     """At the paper's Ch and the finest dp where both finished: reproduced when at every
     station |zeta_u(lind) - zeta_u(skillen)| is below MARGINAL_U or a tie (RESOLVED);
     contradicted when at some station one method's error is more than twice the other's
-    and the difference above both."""
+    and the difference exceeds MARGINAL_U by more than 2 se of the two runs' sampling errors
+    combined (``zeta_u_se``; an unknown se never contradicts)."""
     st = ds["station"].values
     ch, dp, why_not = _both_methods(ds, [("zeta_u", x) for x in st])
     if dp is None:
@@ -304,12 +308,15 @@ def marginal_shifting_claim(ds, claim):
     marginal, large, parts = 0, 0, []
     for x in st:
         lv, sv = (_value(ds, "zeta_u", dp, ch, s, x) for s in ("lind", "skillen"))
+        two_se = 2.0 * math.hypot(*(_se(ds, "zeta_u", dp, ch, s, x) for s in ("lind", "skillen")))
         diff = abs(lv - sv)
         if diff <= MARGINAL_U or diff <= RESOLVED * max(lv, sv):
             marginal += 1
-        elif max(lv, sv) > 2 * min(lv, sv):
+        elif max(lv, sv) > 2 * min(lv, sv) and diff - two_se > MARGINAL_U:
             large += 1
-        parts.append(f"x* = {x:g}: lind {lv:.3f}, skillen {sv:.3f}")
+        noise = "" if two_se == 0 else (" (difference ± 2 se unknown)" if not np.isfinite(two_se)
+                                        else f" (difference {diff:.3f} ± {two_se:.3f}, 2 se)")
+        parts.append(f"x* = {x:g}: lind {lv:.3f}, skillen {sv:.3f}{noise}")
     verdict = ("reproduced" if marginal == st.size else "contradicted" if large else "not reproduced")
     evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts)
     sels = [dict(dp=dp, ch=ch, shifting=s) for s in ("lind", "skillen")]
@@ -372,7 +379,7 @@ METRICS = (("zeta_f", None), ("zeta_h", None), ("zeta_h_paper", None), ("zeta_fs
 def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
     """Per metric (zeta_u per station) and shifting method at the paper's Ch: the cheapest
     steady run meeting each threshold (over the whole grid; a metric with a sampling error,
-    ``{var}_se``, meets it only when below by more than 2 se), the GCI limit and band, and the
+    ``case_{var}_se``, meets it only when below by more than 2 se), the GCI limit and band, and the
     dp that the observed order says is needed for 1 %. ``cheapest[thr]`` is None or (case,
     wall time, value, 2 se or None)."""
     from .pareto import cheapest_meeting
@@ -384,7 +391,9 @@ def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
         for x in stations:
             label = var if x is None else f"{var} (x* = {x:g})"
             err = ds[f"case_{var}"].values if x is None else ds["case_zeta_u"].sel(station=x).values
-            two_se = 2.0 * ds[f"case_{var}_se"].values if x is None and f"case_{var}_se" in ds else None
+            se_name = f"case_{var}_se"
+            two_se = None if se_name not in ds else (
+                2.0 * ds[se_name].values if x is None else 2.0 * ds[se_name].sel(station=x).values)
             bound = err if two_se is None else err + two_se  # NaN where the se is unknown
             cheapest = {}
             for thr in thresholds:
