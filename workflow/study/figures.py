@@ -103,11 +103,18 @@ def _legend(axes, steadiness: bool = True, **kw):
             return
 
 
-def _points(ax, x, y, steady, k, label, band=None):
+def _points(ax, x, y, steady, k, label, band=None, se=None):
     """Filled markers: steady window; hollow: final window of a run that was not steady.
-    One legend entry (``label``) per call; ``band``: a GCI error bar on the finest point."""
+    One legend entry (``label``) per call; ``band``: a GCI error bar on the finest point;
+    ``se``: each point's sampling standard error, drawn as a thin capless bar of +- 2 se."""
     ok = np.isfinite(y) & (y > 0)
     c, m = COLOURS[k % 8], MARKERS[k % 8]
+    if ok.any() and se is not None:
+        e = 2.0 * np.asarray(se, dtype=float)
+        bar = ok & np.isfinite(e) & (e > 0)
+        if bar.any():  # on the log axis a bar reaching zero is drawn down to 5 % of the value
+            ax.errorbar(x[bar], y[bar], yerr=[np.minimum(e[bar], 0.95 * y[bar]), e[bar]], ls="none",
+                        color=c, lw=0.8, capsize=0, alpha=0.7)
     if ok.any():
         ax.plot(x[ok], y[ok], color=c, lw=1, alpha=0.6)
         ax.plot([], [], color=c, lw=1, marker=m, label=label)  # the legend entry
@@ -127,15 +134,25 @@ def _gci_band(dp, y) -> float:
     return extrapolate(dp, y).band
 
 
+def _sampling_error(ds, var, station=None):
+    """``{var}_se`` of the (sub)dataset (at ``station``), or None where the campaign has none."""
+    if f"{var}_se" not in ds:
+        return None
+    se = ds[f"{var}_se"]
+    return se if station is None else se.sel(station=station)
+
+
 def _error_vs_dp(ax, ds, var, shifting, label_ch=True, station=None):
     drawn = False
+    se_all = _sampling_error(ds, var, station)
     for k, ch in enumerate(ds["ch"].values):
         y = ds[var].sel(ch=ch, shifting=shifting)
         if station is not None:
             y = y.sel(station=station)
         steady = ds["steady"].sel(ch=ch, shifting=shifting).values
+        se = None if se_all is None else se_all.sel(ch=ch, shifting=shifting).values
         drawn |= _points(ax, _dp_mm(ds), y.values, steady, k, f"Ch = {ch:g}" if label_ch else None,
-                         band=_gci_band(ds["dp"].values, y.values))
+                         band=_gci_band(ds["dp"].values, y.values), se=se)
     _log_axes(ax, drawn, dp_ticks=_dp_mm(ds))
 
 
@@ -155,7 +172,8 @@ HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over t
           "of a run that did not reach steady state (read them as indicative only). Error bars on "
           "the finest dp: the GCI band of that value (Celik et al. 2008), where the three finest "
           "dp converge monotonically; on the log axis a band that reaches zero is drawn down to "
-          "5 % of the value.")
+          "5 % of the value. Thin bars without caps: +- 2 standard errors of each run's sampling "
+          "error over its averaging window, the same error the verdicts use.")
 
 
 def fig_velocity_profiles(ds, ch, ref):
@@ -243,12 +261,14 @@ def fig_shifting_comparison(ds, var, ch, station_panels=False):
     fig, axs = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.5), squeeze=False)
     for ax, s in zip(axs[0], panels):
         drawn = False
+        se_all = _sampling_error(sub, var, s)
         for k, sh in enumerate(sub["shifting"].values):
             y = sub[var].sel(shifting=sh)
             if s is not None:
                 y = y.sel(station=s)
+            se = None if se_all is None else se_all.sel(shifting=sh).values
             drawn |= _points(ax, _dp_mm(sub), y.values, sub["steady"].sel(shifting=sh).values, k, sh,
-                             band=_gci_band(sub["dp"].values, y.values))
+                             band=_gci_band(sub["dp"].values, y.values), se=se)
         _log_axes(ax, drawn, dp_ticks=_dp_mm(sub))
         ax.set_ylabel(var)
         if s is not None:
