@@ -49,3 +49,25 @@ def test_fig7_colours_by_speed_only_when_the_dataset_has_speeds():
     without = figures.fig_front_particles(ds.drop_vars("front_speed"), 1.8)
     assert len(without.axes) == len(with_speed.axes) - 1  # no colour bar, one colour
     plt.close("all")
+
+
+def test_sampling_error_bars_on_every_point_that_has_one():
+    """With zeta_u_se in the dataset, fig. 8 draws one capless +- 2 se bar per shifting method
+    and station over the dp that have a finite se (here 2 of 3), besides the GCI bands; the
+    upper arm is 2 se long."""
+    ds = campaign(metric)
+    ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], 0.001)
+    ds["zeta_u_se"].loc[dict(dp=0.004)] = np.nan
+    with plt.rc_context(figures.STYLE):
+        fig = figures.fig_shifting_comparison(ds, "zeta_u", 1.8, station_panels=True)
+    for ax in fig.axes:
+        bars = [c for c in ax.containers if c.__class__.__name__ == "ErrorbarContainer"]
+        se_bars = [b for b in bars if not b.lines[1]]  # no caps
+        assert len(se_bars) == 2  # skillen and lind
+        segs = se_bars[0].lines[2][0].get_segments()
+        assert len(segs) == 2
+        top = [max(s[:, 1]) for s in segs]
+        mid = sorted(float(v) for v in ds["zeta_u"].sel(ch=1.8, shifting="skillen", dp=[0.002, 0.001]).sel(
+            station=float(ax.get_title().split("= ")[1])).values)
+        np.testing.assert_allclose(sorted(top), [m + 0.002 for m in mid], rtol=1e-12)
+    plt.close(fig)
