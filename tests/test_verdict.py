@@ -209,3 +209,29 @@ def test_the_cheapest_run_under_a_threshold_honours_zeta_u_sampling_error():
         ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], se)
         row = next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_u (x* = 9.7)")
         assert row["cheapest"][0.05] is None
+
+
+def test_a_trend_within_the_sampling_error_is_flat():
+    """2.27 % then 2.28 % is 'increasing' on values alone, 'flat' within 2 se of 0.05 %; a
+    fall of 0.5 % a refinement stays 'decreasing' with the same se, and a rise of 0.5 % then
+    a fall of 0.05 % is 'increasing'."""
+    from study.verdict import trend
+    dp = [0.002, 0.001]
+    assert trend(dp, [0.0227, 0.0228]) == "increasing"
+    assert trend(dp, [0.0227, 0.0228], [0.0005, 0.0005]) == "flat"
+    assert trend(dp, [0.0227, 0.0228], [0.0, np.nan]) == "increasing"  # an unknown se counts as 0
+    dp3 = [0.004, 0.002, 0.001]
+    assert trend(dp3, [0.03, 0.025, 0.02], [0.0005] * 3) == "decreasing"
+    assert trend(dp3, [0.02, 0.025, 0.0245], [0.0005] * 3) == "increasing"
+
+
+def test_zeta_fs_does_not_converge_within_its_sampling_error():
+    """The paper-like zeta_fs falls with dp (0.1, 0.06, 0.04): reproduced with se = 0.001; with
+    se = 0.02 a run both steps lie within 2 se of the two (0.057): flat at every Ch, not
+    reproduced."""
+    ds = campaign(paper_like)
+    ds["zeta_fs_se"] = xr.full_like(ds["zeta_fs"], 0.001)
+    assert by_claim(ds)["zeta_fs"].verdict == "reproduced"
+    ds["zeta_fs_se"] = xr.full_like(ds["zeta_fs"], 0.02)
+    v = by_claim(ds)["zeta_fs"]
+    assert v.verdict == "not reproduced" and v.evidence.count("(flat)") == 3

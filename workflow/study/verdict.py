@@ -185,33 +185,41 @@ def threshold_claim(ds, var, threshold, chs, sh, need, claim):
     return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
 
 
-def trend(dp, phi) -> str:
+def trend(dp, phi, se=None) -> str:
     """'decreasing' (each finer dp no worse, the finest better than the coarsest),
-    'increasing' (the reverse), 'mixed', or 'insufficient' (fewer than two values)."""
+    'increasing' (the reverse), 'mixed', or 'insufficient' (fewer than two values). With
+    sampling errors ``se`` (one a value; NaN unknown, taken as 0), a change between two
+    values within 2 se of the two combined counts as none, and a sequence with no other
+    change is 'flat'."""
     dp = np.asarray(dp, dtype=float)
     phi = np.asarray(phi, dtype=float)
+    err = np.zeros_like(phi) if se is None else np.nan_to_num(np.asarray(se, dtype=float), nan=0.0)
     ok = np.isfinite(dp) & np.isfinite(phi)
     if ok.sum() < 2:
         return "insufficient"
     order = np.argsort(dp[ok])[::-1]  # coarse to fine
-    d = np.diff(phi[ok][order])
+    v, e = phi[ok][order], err[ok][order]
+    d = np.diff(v)
+    d[np.abs(d) <= 2.0 * np.hypot(e[1:], e[:-1])] = 0.0
     if np.all(d <= 0) and d.sum() < 0:
         return "decreasing"
     if np.all(d >= 0) and d.sum() > 0:
         return "increasing"
-    return "mixed"
+    return "flat" if se is not None and np.all(d == 0) else "mixed"
 
 
 def converging_claim(ds, var, chs, sh, claim, about=None):
-    """``var`` falls with refinement for most of ``chs``; with ``about`` = (value, factor),
+    """``var`` falls with refinement, beyond its sampling errors (``trend``), for most of
+    ``chs``; with ``about`` = (value, factor),
     also that its GCI limit at the paper's Ch lies within that factor of the value
     (contradicted when the whole GCI band lies outside it, not reproduced when only the
     limit does)."""
-    counts = {"decreasing": 0, "increasing": 0, "mixed": 0, "insufficient": 0}
+    counts = {"decreasing": 0, "increasing": 0, "mixed": 0, "flat": 0, "insufficient": 0}
     sels, parts = [], []
     for ch in chs:
         da = _finite_dp(_series(ds, var, ch, sh))
-        t = trend(da["dp"].values, da.values)
+        se = None if f"{var}_se" not in ds else _series(ds, f"{var}_se", ch, sh).sel(dp=da["dp"]).values
+        t = trend(da["dp"].values, da.values, se)
         counts[t] += 1
         sels += [dict(dp=float(d), ch=ch, shifting=sh) for d in da["dp"].values]
         if da.sizes["dp"]:
