@@ -185,8 +185,10 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         "zeta_h_paper": "uniform depth error against the paper's normalising depth",
         "zeta_fs": "free-surface RMS error against the theory",
         "zeta_u": "velocity-profile RMS error against the theory",
-        "zeta_h_se": "standard error of zeta_h over the averaging window (block jackknife)",
-        "zeta_h_paper_se": "standard error of zeta_h_paper over the averaging window (block jackknife)",
+        "zeta_h_se": "standard error of zeta_h over the averaging window (block jackknife and half "
+                     "the depth's drift through it)",
+        "zeta_h_paper_se": "standard error of zeta_h_paper over the averaging window (block jackknife "
+                           "and half the depth's drift through it)",
         "zeta_fs_se": "standard error of zeta_fs over the averaging window (block jackknife)",
         "zeta_u_se": "standard error of zeta_u over the averaging window (block jackknife)",
         "zeta_fs_measured": "free-surface RMS error against measured data",

@@ -60,7 +60,7 @@ def _with_error(value, se) -> str:
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
     head = ["case", "status", "steady", "wall time [s]", "steps", "particles", "steady at [s]",
-            "zeta_f (± 2 se)", "zeta_h (h_n, ± 2 se)", "zeta_h (paper)", "zeta_fs (± 2 se)"] + [
+            "zeta_f (± 2 se)", "zeta_h (h_n, ± 2 se)", "zeta_h (paper, ± 2 se)", "zeta_fs (± 2 se)"] + [
                 f"zeta_u x*={s:g} (± 2 se)" for s in st]
     rows = []
     for i, cid in enumerate(ds["case"].values):
@@ -73,7 +73,7 @@ def case_table(ds: xr.Dataset) -> str:
         for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time"):
             cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
         for k in ("case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
-            se = ds[f"{k}_se"].values[i] if f"{k}_se" in ds and k != "case_zeta_h_paper" else None
+            se = ds[f"{k}_se"].values[i] if f"{k}_se" in ds else None
             cells.append(f"<td>{_with_error(ds[k].values[i], se)}</td>")
         for j in range(st.size):
             se = ds["case_zeta_u_se"].values[i, j] if "case_zeta_u_se" in ds else None

@@ -15,7 +15,7 @@ A metric with a sampling error in the campaign dataset (``{var}_se``: zeta_f fro
 scatter; zeta_h, zeta_fs and zeta_u per station by the block jackknife of study.metrics) is
 below or above a threshold only by more than 2 se, and two runs within 2 se of each other
 tie; a run whose sampling error could not be measured (NaN: too few samples) is neither below
-nor above, and ties.
+nor above, and ties. Along dp, a change within 2 se of its two runs counts as none (``trend``).
 """
 from __future__ import annotations
 
