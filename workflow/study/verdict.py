@@ -285,7 +285,8 @@ def lind_better_claim(ds, claim):
     better, worse, parts = 0, 0, []
     for var in ("zeta_f", "zeta_h"):
         lv, sv = (_value(ds, var, dp, ch, s) for s in ("lind", "skillen"))
-        two_se = 2.0 * math.hypot(_se(ds, var, dp, ch, "lind"), _se(ds, var, dp, ch, "skillen"))
+        lse, sse = (_se(ds, var, dp, ch, s) for s in ("lind", "skillen"))
+        two_se = 2.0 * math.hypot(lse, sse)
         if not np.isfinite(two_se):
             word = "tie: sampling error unknown"
         elif abs(lv - sv) <= max(RESOLVED * max(lv, sv), two_se):
@@ -294,7 +295,6 @@ def lind_better_claim(ds, claim):
             word, better = "lind better", better + 1
         else:
             word, worse = "skillen better", worse + 1
-        lse, sse = (_se(ds, var, dp, ch, s) for s in ("lind", "skillen"))
         err = lambda se: f" ± {_pct(2 * se)}" if np.isfinite(se) and se > 0 else ""  # noqa: E731
         parts.append(f"{var}: lind {_pct(lv)}{err(lse)}, skillen {_pct(sv)}{err(sse)} ({word})")
     verdict = "reproduced" if better == 2 else "contradicted" if worse == 2 else "not reproduced"
