@@ -113,6 +113,36 @@ def test_solver_level_errors_are_caught_before_jobs():
         cfgmod.validate(c)
 
 
+def test_case_overrides_apply_to_the_matching_cases_only_in_order():
+    c = load("config.yaml")
+    c["grid"] = {"dp": [2e-3, 1e-3], "ch": [1.8], "shifting": ["skillen", "lind"]}
+    c["case_overrides"] = [{"where": {"dp": "1.0e-3"}, "case": {"steady": {"min_time": 2.0}}},
+                           {"where": {"dp": 1e-3, "shifting": "lind"}, "case": {"steady": {"min_time": 3.0}}}]
+    c["extra_cases"] = [{"dp": 1e-3, "ch": 1.3, "shifting": "skillen", "tag": "own",
+                         "overrides": {"steady": {"min_time": 2.5}}}]
+    cfg = cfgmod.validate(c)
+    min_time = {x.id: cfgmod.case_dict(cfg, x)["steady"].get("min_time") for x in cfgmod.cases(cfg)}
+    assert min_time == {"dp2mm_ch1.8_skillen": None, "dp2mm_ch1.8_lind": None,
+                        "dp1mm_ch1.8_skillen": 2.0, "dp1mm_ch1.8_lind": 3.0, "dp1mm_ch1.3_skillen_own": 2.5}
+    # the rest of the steady block is merged, not replaced
+    assert cfgmod.case_dict(cfg, cfgmod.cases(cfg)[2])["steady"]["max_time"] == c["case"]["steady"]["max_time"]
+
+
+@pytest.mark.parametrize("entry, message", [
+    ({"where": {"dpp": 1e-3}, "case": {"steady": {"min_time": 2.0}}}, "config key case_overrides.0.where: "),
+    ({"where": {}, "case": {"steady": {"min_time": 2.0}}}, "config key case_overrides.0.where: "),
+    ({"where": {"dp": 1e-3}, "case": {"dp": 2e-3}}, "config key case_overrides.0.case: "),
+    ({"where": {"dp": 1e-3}}, "config key case_overrides.0: "),
+    ({"where": {"dp": 1e-3}, "case": {"steady": {"average": 0.1}}}, "case dp1mm_ch1.8_skillen: "),
+])
+def test_bad_case_overrides_are_refused_naming_the_key(entry, message):
+    c = load("config.yaml")
+    c["case_overrides"] = [entry]
+    with pytest.raises(cfgmod.ConfigError) as exc:
+        cfgmod.validate(c)
+    assert message in str(exc.value)
+
+
 # ---- reference and metrics ---------------------------------------------------------------
 def test_reference_stations():
     ref = theory(np.array([0.0, 0.76, 1.5, 9.7]), [0.76, 1.5, 9.7], np.linspace(0, 1.3, 53), 15.3)

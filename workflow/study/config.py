@@ -7,7 +7,7 @@ from pathlib import Path
 
 import yaml
 
-from .grid import Case, expand
+from .grid import Case, expand, matches
 
 SCHEMA = Path(__file__).resolve().parent / "config.schema.yaml"
 
@@ -129,8 +129,14 @@ def solver_case(cfg: dict, case: Case | None = None):
 
 
 def case_dict(cfg: dict, case: Case) -> dict:
-    """The solver's case file (solver.conveyor) for one campaign case."""
-    d = _merge(cfg["case"], case.overrides)
+    """The solver's case file (solver.conveyor) for one campaign case: ``case``, then each
+    ``case_overrides`` entry whose ``where`` the case matches (in order), then an extra
+    case's own ``overrides``."""
+    d = copy.deepcopy(cfg["case"])
+    for entry in cfg.get("case_overrides") or []:
+        if matches(entry["where"], case.dp, case.ch, case.shifting):
+            d = _merge(d, entry["case"])
+    d = _merge(d, case.overrides)
     src = warm_source(cfg, case)
     if src is not None:
         d.update(start="warm", warm_from=run_path(src))

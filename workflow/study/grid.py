@@ -36,6 +36,13 @@ class Case:
         return self.tag is None
 
 
+def matches(selector: dict, dp: float, ch: float, shifting: str) -> bool:
+    """Whether a case has every value the selector names (any of dp, ch, shifting; numbers
+    compared as floats, so 1e-3, 1.0e-3 and 0.001 are one dp)."""
+    values = {"dp": dp, "ch": ch, "shifting": shifting}
+    return all(values[k] == (v if k == "shifting" else float(v)) for k, v in selector.items())
+
+
 def expand(grid: dict, extra: list[dict] | None = None) -> list[Case]:
     """Cases of the grid (``combine``: product, or paper = every Ch with the first shifting
     method plus every method at ``paper_ch``), less those matching an ``exclude`` entry,
@@ -45,9 +52,7 @@ def expand(grid: dict, extra: list[dict] | None = None) -> list[Case]:
     excluded = grid.get("exclude") or []
 
     def left_out(dp, ch, sh):
-        values = {"dp": dp, "ch": ch, "shifting": sh}
-        return any(all(values[k] == (v if k == "shifting" else float(v)) for k, v in e.items())
-                   for e in excluded)
+        return any(matches(e, dp, ch, sh) for e in excluded)
 
     cases = []
     for dp in dps:
