@@ -128,7 +128,7 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
                 if jx < 0:
                     continue
                 j0, j1 = column_window(cl, z, jx, iz, gz - 2.0 * h)
-                for j in range(j0, j1):
+                for j in range(np.uint64(j0), np.uint64(j1)):  # unsigned: no wrap-around on loads
                     if z[j] >= gz + 2.0 * h:
                         break
                     if kind[j] != 0:

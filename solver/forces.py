@@ -338,7 +338,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                             nx_hi += 1
                         for side in range(2):
                             first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
-                            for b in range(first, b1):
+                            # unsigned: no negative-index wrap-around on the loads and stores of b
+                            for b in range(np.uint64(first), np.uint64(b1)):
                                 kb = kind[b]
                                 if ka + kb == 2:
                                     continue
