@@ -28,7 +28,8 @@ c = delta / dt - a of that step (carried with the particles): a fifth fewer iter
 
 The pair loop lists the fluid pairs with k_ab = c_ab / m_b (``forces.PairList``, per thread,
 each pair once) and sums the diagonal sum_b c_ab; ``sort_pairs`` arranges the list by rows
-(``Rows``), over which the products of CG run.
+(``Rows``), over which the products of CG run. The sub-stepped update (``substep``) runs its
+products over the per-thread lists themselves.
 """
 from __future__ import annotations
 
@@ -37,6 +38,8 @@ from typing import NamedTuple
 
 import numba as nb
 import numpy as np
+
+from .forces import thread_rows
 
 TOLERANCE = 1.0e-6  # CG stops when |residual| <= TOLERANCE |right-hand side| (2-norm, each component)
 MAX_ITERATIONS = 1000
@@ -54,9 +57,12 @@ def pair_capacity(n: int, ch: float, threads: int) -> int:
     return int(pairs_per_particle(ch) * n / threads) + 1024
 
 
-def bytes_per_particle(ch: float) -> float:
-    """Memory this update adds: the pair list (16 B a pair) and its arrangement by rows (24 B
-    a pair), and 14 numbers of scratch and row offsets (2 threads); 1.3 kB at Ch = 1.8."""
+def bytes_per_particle(ch: float, substeps: bool = False) -> float:
+    """Memory this update adds (2 threads): the pair list (16 B a pair) and, for CG, its
+    arrangement by rows (24 B a pair) and 14 numbers of scratch and row offsets, 1.3 kB at
+    Ch = 1.8; sub-stepped, 10 numbers of stages and per-thread sums, 0.57 kB at Ch = 1.8."""
+    if substeps:
+        return pairs_per_particle(ch) * 16.0 + 80.0
     return pairs_per_particle(ch) * 40.0 + 112.0
 
 
@@ -273,11 +279,15 @@ def rkc_coefficients(s: int, damping: float = RKC_DAMPING):
 
 @nb.njit(parallel=True, cache=True)
 def _largest_diagonal(diag, kind, n):
-    m = np.zeros(n)
-    for a in nb.prange(n):
-        if kind[a] == 0:
-            m[a] = diag[a]
-    return m.max() if n > 0 else 0.0
+    chunks = 64
+    m = np.zeros(chunks)
+    for c in nb.prange(chunks):
+        v = 0.0
+        for a in range(c * n // chunks, (c + 1) * n // chunks):
+            if kind[a] == 0 and diag[a] > v:
+                v = diag[a]
+        m[c] = v
+    return m.max()
 
 
 def eigenvalue_bound(diag, kind, n: int) -> float:
@@ -286,40 +296,112 @@ def eigenvalue_bound(diag, kind, n: int) -> float:
     return 2.0 * float(_largest_diagonal(diag, kind, n))
 
 
+SUBSTEP_WORK_ROWS = 6
+
+
+def substep_accumulators(threads: int, n: int) -> np.ndarray:
+    """Per-thread scratch of ``substep``: each thread's share of C's off-diagonal products."""
+    return np.zeros((threads, n, 2))
+
+
 @nb.njit(parallel=True, cache=True)
-def _rkc_stage(ptr, cols, wts, diag, kind, ax, az, y1x, y1z, y2x, y2z, outx, outz, mu, nu, mut_dt, n):
-    """out = mu y1 + nu y2 + mut dt (a - C y1) on the fluid rows (Y_0 = 0)."""
+def _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
+                        periodic):
+    """acc[t, a] = sum over thread t's listed pairs (a, b) of c_ab y_b, c_ab = m_b k_ab (both
+    directions of each pair), on the rows thread t writes (``forces.thread_rows``)."""
+    for t in nb.prange(pair_count.size):
+        at = acc[t]
+        lo, hi = thread_rows(start, split, t, ncx, ncz)
+        at[lo:hi] = 0.0
+        if periodic and split[t + 1] == ncx:
+            at[0:start[ncz]] = 0.0
+        for q in range(np.uint64(pair_count[t])):
+            a = np.uint64(pair_i[t, q])
+            b = np.uint64(pair_j[t, q])
+            k = pair_k[t, q]
+            wa = mass[b] * k
+            wb = mass[a] * k
+            at[a, 0] += wa * yx[b]
+            at[a, 1] += wa * yz[b]
+            at[b, 0] += wb * yx[a]
+            at[b, 1] += wb * yz[a]
+
+
+@nb.njit(parallel=True, cache=True)
+def _rkc_stage(acc, start, split, ncx, ncz, periodic, diag, kind, ax, az, y1x, y1z, y2x, y2z,
+               outx, outz, mu, nu, mut_dt, n):
+    """out = mu y1 + nu y2 + mut dt (a - C y1) on the fluid rows, 0 elsewhere (Y_0 = 0), with
+    (C y1)_a = diag_a y1_a - sum_b c_ab y1_b and the off-diagonal sums from ``acc``."""
     for a in nb.prange(n):
-        if kind[a] != 0:
+        if kind[a] == 0:
+            outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - diag[a] * y1x[a])
+            outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - diag[a] * y1z[a])
+        else:
             outx[a] = outz[a] = 0.0
-            continue
-        sx, sz = _row_sums(ptr, cols, wts, y1x, y1z, a)
-        cx = diag[a] * y1x[a] - sx
-        cz = diag[a] * y1z[a] - sz
-        outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - cx)
-        outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - cz)
+    nt = acc.shape[0]
+    for t in range(nt):  # listed pairs are fluid pairs: other rows of acc hold zeros
+        lo, hi = thread_rows(start, split, t, ncx, ncz)
+        for a in nb.prange(lo, hi):
+            outx[a] += mut_dt * acc[t, a, 0]
+            outz[a] += mut_dt * acc[t, a, 1]
+        if periodic and split[t + 1] == ncx and split[t] > 0:
+            for a in nb.prange(start[ncz]):
+                outx[a] += mut_dt * acc[t, a, 0]
+                outz[a] += mut_dt * acc[t, a, 1]
 
 
-def substep(ptr, cols, wts, diag, kind, dt: float, ax, az, n: int, work) -> int:
+@nb.njit(parallel=True, cache=True)
+def _first_stage(kind, ax, az, y0x, y0z, y1x, y1z, mut_dt, n):
+    """Y_0 = 0, Y_1 = mut_1 dt a on the fluid rows."""
+    for a in nb.prange(n):
+        y0x[a] = y0z[a] = 0.0
+        if kind[a] == 0:
+            y1x[a] = mut_dt * ax[a]
+            y1z[a] = mut_dt * az[a]
+        else:
+            y1x[a] = y1z[a] = 0.0
+
+
+@nb.njit(parallel=True, cache=True)
+def _take_increment(kind, dx, dz, ax, az, inv_dt, n):
+    for a in nb.prange(n):
+        if kind[a] == 0:
+            ax[a] = dx[a] * inv_dt
+            az[a] = dz[a] * inv_dt
+
+
+def substep(pairs, cl, split, diag, mass, kind, dt: float, ax, az, n: int, work, acc) -> int:
     """Overwrite (ax, az) of the fluid rows of [0, n) with delta / dt, delta integrating
     d delta / dt = a - C delta from 0 over dt (the laminar term at v^n + delta, the rest at
     the evaluation) by first-order RKC with as many stages as ``rkc_stages`` asks for dt
-    times ``eigenvalue_bound``: explicit stages, each one product with C. Returns the stages."""
+    times ``eigenvalue_bound``: explicit stages, each one product with C, summed over the
+    pair loop's lists (``forces.PairList`` ``pairs``, thread t's pairs on the rows it writes:
+    ``cells.CellList`` cl, column ``split``) into the per-thread ``acc``
+    (``substep_accumulators``); ``work``: scratch of shape (SUBSTEP_WORK_ROWS, >= n).
+    Returns the stages."""
     s = rkc_stages(dt * eigenvalue_bound(diag, kind, n))
     _, mu, nu, mut = rkc_coefficients(s)
     ys = [(work[0], work[1]), (work[2], work[3]), (work[4], work[5])]  # Y_{j-2}, Y_{j-1}, Y_j
-    for y in ys:
-        y[0][:n] = 0.0
-        y[1][:n] = 0.0
-    fluid = kind[:n] == 0
-    # Y_1 = mut_1 dt a
-    ys[1][0][:n] = np.where(fluid, mut[1] * dt * ax[:n], 0.0)
-    ys[1][1][:n] = np.where(fluid, mut[1] * dt * az[:n], 0.0)
+    _first_stage(kind, ax, az, *ys[0], *ys[1], mut[1] * dt, n)
+    grid = (cl.start, split, cl.ncx, cl.ncz, cl.periodic)
     for j in range(2, s + 1):
         (y2x, y2z), (y1x, y1z), (ox, oz) = ys
-        _rkc_stage(ptr, cols, wts, diag, kind, ax, az, y1x, y1z, y2x, y2z, ox, oz, mu[j], nu[j], mut[j] * dt, n)
+        _offdiagonal_shares(*pairs, mass, y1x, y1z, acc, *grid)
+        _rkc_stage(acc, *grid, diag, kind, ax, az, y1x, y1z, y2x, y2z, ox, oz, mu[j], nu[j], mut[j] * dt, n)
         ys = [ys[1], ys[2], ys[0]]
-    dx, dz = ys[1]
-    ax[:n] = np.where(fluid, dx[:n] / dt, ax[:n])
-    az[:n] = np.where(fluid, dz[:n] / dt, az[:n])
+    _take_increment(kind, *ys[1], ax, az, 1.0 / dt, n)
     return s
+
+
+@nb.njit(parallel=True, cache=True)
+def largest_fluid_acceleration(ax, az, kind, n):
+    """max |a| over the fluid particles of [0, n) (0 for none)."""
+    chunks = 64
+    m = np.zeros(chunks)
+    for c in nb.prange(chunks):
+        v = 0.0
+        for a in range(c * n // chunks, (c + 1) * n // chunks):
+            if kind[a] == 0:
+                v = max(v, ax[a] * ax[a] + az[a] * az[a])
+        m[c] = v
+    return math.sqrt(m.max())

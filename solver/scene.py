@@ -587,7 +587,7 @@ def validate(scene: Scene) -> None:
     per_particle = BYTES_PER_PARTICLE
     if scene.implicit_viscosity:
         from .implicit import bytes_per_particle
-        per_particle += bytes_per_particle(scene.ch)
+        per_particle += bytes_per_particle(scene.ch, scene.viscous_substeps)
     need = n * per_particle / 1e9
     if need > scene.memory_budget_gb:
         raise SceneError(

@@ -120,7 +120,10 @@ class Simulation:
         # implicit viscosity: the pair loop's list of fluid pairs, CG scratch
         cap = implicit.pair_capacity(self.n, s.ch, self.nthreads) if self.implicit else 0
         self.pairs = forces.pair_list(self.nthreads, cap)
-        if self.implicit:
+        if self.implicit and self.substeps:
+            self.substep_acc = implicit.substep_accumulators(self.nthreads, self.n)
+            self.solver_work = np.zeros((implicit.SUBSTEP_WORK_ROWS, self.n))
+        elif self.implicit:
             self.rows = implicit.rows_for(self.nthreads, self.n, cap)
             self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
         cg = self.implicit and not self.substeps
@@ -207,7 +210,8 @@ class Simulation:
             # more pairs than the list holds: widen it and evaluate again
             cap = int(1.25 * self.pairs.count.max())
             self.pairs = forces.pair_list(self.nthreads, cap)
-            self.rows = implicit.rows_for(self.nthreads, self.n, cap)
+            if not self.substeps:
+                self.rows = implicit.rows_for(self.nthreads, self.n, cap)
             self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.cells,
                                                s.gravity[0], s.gravity[1], self.out, self.n)
@@ -230,13 +234,13 @@ class Simulation:
         limit of the next step takes their maximum."""
         o = self.out
         n = self.n_active
-        implicit.sort_pairs(*self.pairs[:3], self.pairs.count, self.mass, n, self.rows)
         if self.substeps:  # RKC stages instead of the backward-Euler solve
-            self.rkc_stages += implicit.substep(*self.rows[:3], o[self.nq - 1], self.kind, dt, o[forces.AX],
-                                                o[forces.AZ], n, self.solver_work)
-            fluid = self.kind[:n] == 0
-            self.amax = float(np.hypot(o[forces.AX, :n][fluid], o[forces.AZ, :n][fluid]).max(initial=0.0))
+            self.rkc_stages += implicit.substep(self.pairs, self.cells, self.split, o[self.nq - 1], self.mass,
+                                                self.kind, dt, o[forces.AX], o[forces.AZ], n,
+                                                self.solver_work, self.substep_acc)
+            self.amax = float(implicit.largest_fluid_acceleration(o[forces.AX], o[forces.AZ], self.kind, n))
             return ""
+        implicit.sort_pairs(*self.pairs[:3], self.pairs.count, self.mass, n, self.rows)
         it, res = implicit.solve(*self.rows[:3], o[self.nq - 1], self.mass, self.kind, dt, o[forces.AX],
                                  o[forces.AZ], self.implicit_cx, self.implicit_cz, n, implicit.TOLERANCE,
                                  implicit.MAX_ITERATIONS, self.solver_work)
@@ -244,8 +248,7 @@ class Simulation:
         if not res <= implicit.TOLERANCE:
             return (f"implicit viscous solve: relative residual {res:.3g} after {it} iterations "
                     f"(tolerance {implicit.TOLERANCE:g})")
-        fluid = self.kind[:n] == 0
-        self.amax = float(np.hypot(o[forces.AX, :n][fluid], o[forces.AZ, :n][fluid]).max(initial=0.0))
+        self.amax = float(implicit.largest_fluid_acceleration(o[forces.AX], o[forces.AZ], self.kind, n))
         return ""
 
     def _correct_density(self):

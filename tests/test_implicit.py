@@ -271,15 +271,20 @@ def test_a_pair_list_that_overflows_is_widened_and_the_evaluation_repeated():
     assert np.allclose(C, C2, rtol=1e-12, atol=0)
 
 
-def test_the_memory_estimate_covers_what_the_implicit_update_allocates():
+@pytest.mark.parametrize("update", ["implicit", "substepped"])
+def test_the_memory_estimate_covers_what_the_implicit_update_allocates(update):
     """implicit.bytes_per_particle, which the scene's memory check adds, against the arrays'
-    own sizes (plus the fixed 1024 pairs of slack per thread)."""
-    sc, sim = jittered_couette()
-    held = (sum(a.nbytes for a in sim.pairs) + sum(a.nbytes for a in sim.rows)
-            + sim.solver_work.nbytes)
-    slack = sim.nthreads * 1024 * 40
-    assert held <= sim.n * implicit.bytes_per_particle(sc.ch) + slack + 64
-    assert held >= 0.9 * sim.n * implicit.bytes_per_particle(sc.ch)
+    own sizes (plus the fixed 1024 pairs of slack per thread), with both updates."""
+    sc = example_scene("couette", physics={"viscous_update": update})
+    sim = Simulation(sc, build_particles(sc))
+    substeps = update == "substepped"
+    assert sim.substeps == substeps
+    held = sum(a.nbytes for a in sim.pairs) + sim.solver_work.nbytes
+    held += sim.substep_acc.nbytes if substeps else sum(a.nbytes for a in sim.rows)
+    slack = sim.nthreads * 1024 * (16 if substeps else 40)
+    estimate = sim.n * implicit.bytes_per_particle(sc.ch, substeps)
+    assert held <= estimate + slack + 64
+    assert held >= 0.9 * estimate
 
 
 def rkc_dense(C, dt, a):
@@ -309,8 +314,9 @@ def test_the_substepped_update_is_runge_kutta_chebyshev_on_the_same_operator(dt_
     dt = dt_over_dt3 * sc.h ** 2 / sc.nu
     expect_x, s = rkc_dense(C, dt, ax[rows])
     expect_z, _ = rkc_dense(C, dt, az[rows])
-    stages = implicit.substep(*sim.rows[:3], sim.out[sim.nq - 1], sim.kind, dt, ax, az, sim.n_active,
-                              sim.solver_work)
+    stages = implicit.substep(sim.pairs, sim.cells, sim.split, sim.out[sim.nq - 1], sim.mass, sim.kind, dt,
+                              ax, az, sim.n_active, np.zeros((implicit.SUBSTEP_WORK_ROWS, sim.n)),
+                              implicit.substep_accumulators(sim.nthreads, sim.n))
     assert stages == s
     scale = np.abs(expect_x).max()
     assert np.abs(ax[rows] - expect_x).max() < 1e-9 * scale
