@@ -56,7 +56,7 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--compile-dp", type=float, default=0.001)
     ap.add_argument("--compile-set", action="append", default=[],
-                    help="KEY=VALUE for the compile run only (viscous_update=substepped: the update dp = 0.25 mm takes)")
+                    help="KEY=VALUE of the compile run only (viscous_update=substepped: dp = 0.25 mm's update)")
     a = ap.parse_args(argv)
     case = a.case.resolve()
     trees = {"old": a.old, "new": a.new}

@@ -66,7 +66,7 @@ def main(argv=None):
     ap.add_argument("--calls", type=int, default=20)
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
-    from solver import forces, implicit
+    from solver import implicit
     import_tree(a.old_tree, "solver_old")
     old_implicit = importlib.import_module("solver_old.implicit")
     sim, kept = simulation(a.dp, a.ch, a.warmup)
