@@ -1,9 +1,9 @@
 """The implicit laminar update's CG solve on the matrices of a real run: iterations, time and
-solution error for several tolerances and row-weight precisions, and the iterations with and
+solution error for several tolerances and pair-weight precisions, and the iterations with and
 without CG's start from the last step's correction.
 
 Runs the paper case (examples/conveyor_fast.yaml's scheme, implicit update) at the given dp
-for a few steps, keeps the systems of the last ``--systems`` steps (rows, diagonal, right-hand
+for a few steps, keeps the systems of the last ``--systems`` steps (the operator, right-hand
 side, dt), and solves each of them with every variant in turn from the explicit step,
 alternating variants so that a noisy host biases none of them. The error of a variant is
 measured against a solve to 1e-12: the largest |v^{n+1} - v^{n+1}_exact| over the fluid, as a
@@ -29,7 +29,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def capture(dp: float, ch: float, steps: int, systems: int):
     """Step the case and keep the CG systems of its last ``systems`` steps: (the systems,
     the belt speed, the simulation, its own ``_solve_viscous``)."""
-    from solver import forces, implicit
+    from solver import forces
     from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
     from solver.build import build_particles
     from solver.scene import read_yaml
@@ -48,11 +48,9 @@ def capture(dp: float, ch: float, steps: int, systems: int):
 
     def keep(dt):
         n = sim.n_active
-        implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, n, sim.rows)
-        ptr = sim.rows.ptr[: n + 1].copy()
-        kept.append({"ptr": ptr, "cols": sim.rows.cols[: ptr[n]].copy(), "wts": sim.rows.wts[: ptr[n]].copy(),
-                     "diag": sim.out[sim.nq - 1, :n].copy(), "ax": sim.out[forces.AX, :n].copy(),
-                     "az": sim.out[forces.AZ, :n].copy(), "dt": dt, "n": n})
+        op = [a.copy() if isinstance(a, np.ndarray) else a for a in sim.viscous_operator()]
+        kept.append({"op": op, "kind": sim.kind.copy(), "ax": sim.out[forces.AX].copy(),
+                     "az": sim.out[forces.AZ].copy(), "dt": dt, "n": n, "pairs": int(sim.pairs.count.sum())})
         del kept[:-systems]
         return original(dt)
 
@@ -90,16 +88,19 @@ def start_comparison(sim, original, blocks: int) -> dict:
     return its, walls
 
 
-def solve(system: dict, sim, tol: float, wts) -> tuple[np.ndarray, np.ndarray, int, float]:
+def solve(system: dict, tol: float, weights) -> tuple[np.ndarray, np.ndarray, int, float]:
+    """CG on a kept system from the explicit step, with the pair weights ``weights``."""
     from solver import implicit
     ax = system["ax"].copy()
     az = system["az"].copy()
-    work = np.zeros((implicit.WORK_ROWS, system["n"]))
+    work = np.zeros((implicit.WORK_ROWS, ax.size))
+    op = list(system["op"])
+    op[2] = weights
     tic = time.perf_counter()
-    zero = np.zeros(system["n"])
-    it, _ = implicit.solve(system["ptr"], system["cols"], wts, system["diag"], sim.mass, sim.kind, system["dt"],
-                           ax, az, zero, zero.copy(), system["n"], tol, implicit.MAX_ITERATIONS, work)
-    return ax, az, it, time.perf_counter() - tic
+    zero = np.zeros(ax.size)
+    it, _ = implicit.solve(tuple(op), system["kind"], system["dt"], ax, az, zero, zero.copy(), system["n"], tol,
+                           implicit.MAX_ITERATIONS, work)
+    return ax[:system["n"]], az[:system["n"]], it, time.perf_counter() - tic
 
 
 def main(argv=None):
@@ -117,14 +118,16 @@ def main(argv=None):
     systems, u_b, sim, original = capture(a.dp, a.ch, a.steps, a.systems)
     variants = [(tol, prec) for tol in a.tol for prec in ("float64", "float32")]
     stats = {v: {"it": [], "t": [], "err": []} for v in variants}
+    for weights in (np.float64, np.float32):  # compile each precision before timing
+        solve(systems[0], 1e-6, systems[0]["op"][2].astype(weights))
     for system in systems:
-        w64 = system["wts"].astype(np.float64)
-        w32 = system["wts"].astype(np.float32)
-        ex, ez, _, _ = solve(system, sim, 1e-12, w64)
-        fluid = sim.kind[: system["n"]] == 0
+        w64 = system["op"][2].astype(np.float64)
+        w32 = system["op"][2].astype(np.float32)
+        ex, ez, _, _ = solve(system, 1e-12, w64)
+        fluid = system["kind"][: system["n"]] == 0
         for r in range(a.rounds):
             for tol, prec in (variants if r % 2 == 0 else variants[::-1]):
-                ax, az, it, t = solve(system, sim, tol, w64 if prec == "float64" else w32)
+                ax, az, it, t = solve(system, tol, w64 if prec == "float64" else w32)
                 err = np.hypot(ax - ex, az - ez)[fluid].max() * system["dt"] / u_b
                 s = stats[(tol, prec)]
                 s["it"].append(it)
@@ -132,9 +135,9 @@ def main(argv=None):
                 s["err"].append(err)
     dt = np.mean([s["dt"] for s in systems])
     n = systems[0]["n"]
-    print(f"dp {a.dp * 1e3:g} mm, Ch {a.ch:g}: {n} particles, {systems[0]['ptr'][n]} row entries, "
+    print(f"dp {a.dp * 1e3:g} mm, Ch {a.ch:g}: {n} particles, {systems[0]['pairs']} pairs, "
           f"mean dt {dt:.3g} s, {len(systems)} systems x {a.rounds} rounds, {a.threads} threads")
-    print("| tolerance | row weights | CG iterations | solve [ms] | ms an iteration "
+    print("| tolerance | pair weights | CG iterations | solve [ms] | ms an iteration "
           "| largest step error / u_b | per simulated s, summed |")
     print("|---|---|---|---|---|---|---|")
     for tol, prec in variants:

@@ -27,14 +27,14 @@ c = delta / dt - a of that step (carried with the particles): a fifth fewer iter
 (12.2 against 15.2 a step at dp = 0.25 mm, Ch = 1.8, ``benchmarks/cg_solve.py``).
 
 The pair loop lists the fluid pairs with k_ab = c_ab / m_b (``forces.PairList``, per thread,
-each pair once) and sums the diagonal sum_b c_ab; ``sort_pairs`` arranges the list by rows
-(``Rows``), over which the products of CG run. The sub-stepped update (``substep``) runs its
-products over the per-thread lists themselves.
+each pair once) and sums the diagonal sum_b c_ab. Every product with C (CG's and the
+sub-stepped update's) runs over those per-thread lists: thread t adds c_ab y_b to row a and
+c_ba y_a to row b of its own accumulator, on the rows it writes (``forces.thread_rows``), and
+the threads' shares are summed (``offdiagonal_products``). The list is never arranged by rows.
 """
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -43,7 +43,8 @@ from .forces import thread_rows
 
 TOLERANCE = 1.0e-6  # CG stops when |residual| <= TOLERANCE |right-hand side| (2-norm, each component)
 MAX_ITERATIONS = 1000
-WORK_ROWS = 11
+WORK_ROWS = 13  # CG's scratch rows
+SUBSTEP_WORK_ROWS = 8  # the sub-stepped update's
 
 
 def pairs_per_particle(ch: float) -> float:
@@ -58,96 +59,90 @@ def pair_capacity(n: int, ch: float, threads: int) -> int:
 
 
 def bytes_per_particle(ch: float, substeps: bool = False) -> float:
-    """Memory this update adds (2 threads): the pair list (16 B a pair) and, for CG, its
-    arrangement by rows (24 B a pair) and 14 numbers of scratch and row offsets, 1.3 kB at
-    Ch = 1.8; sub-stepped, 10 numbers of stages and per-thread sums, 0.57 kB at Ch = 1.8."""
-    if substeps:
-        return pairs_per_particle(ch) * 16.0 + 80.0
-    return pairs_per_particle(ch) * 40.0 + 112.0
+    """Memory this update adds (2 threads): the pair list (16 B a pair), the two threads'
+    product shares (4 numbers) and the scratch rows (13 for CG, 8 sub-stepped): 0.62 and
+    0.58 kB a particle at Ch = 1.8."""
+    return pairs_per_particle(ch) * 16.0 + 8.0 * (4 + (SUBSTEP_WORK_ROWS if substeps else WORK_ROWS))
 
 
-class Rows(NamedTuple):
-    """The off-diagonal of C by rows: row a's fluid neighbours cols[ptr[a]:ptr[a + 1]] with
-    weights c_ab = m_b k_ab; per_thread: scratch counts of shape (threads, n)."""
-    ptr: np.ndarray
-    cols: np.ndarray
-    wts: np.ndarray
-    per_thread: np.ndarray
+def product_shares(threads: int, n: int) -> np.ndarray:
+    """Per-thread scratch of the products: each thread's share of C's off-diagonal sums."""
+    return np.zeros((threads, n, 2))
 
 
-def rows_for(threads: int, n: int, capacity: int) -> Rows:
-    return Rows(np.zeros(n + 1, dtype=np.int64), np.zeros(2 * threads * capacity, dtype=np.int32),
-                np.zeros(2 * threads * capacity), np.zeros((threads, n), dtype=np.int64))
+def operator(pairs, cl, split, diag, mass, shares) -> tuple:
+    """What a product with C reads: the pair loop's lists (``forces.PairList`` pairs), the
+    rows each thread writes (``cells.CellList`` cl, column ``split``), the diagonal
+    sum_b c_ab, the masses, and the scratch ``product_shares``."""
+    return (pairs.i, pairs.j, pairs.k, pairs.count, mass, diag, shares, cl.start, split, cl.ncx, cl.ncz,
+            cl.periodic)
 
 
 @nb.njit(parallel=True, cache=True)
-def _count_rows(pair_i, pair_j, pair_count, cnt, n):
+def _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
+                        periodic):
+    """acc[t, a] = sum over thread t's listed pairs (a, b) of c_ab y_b, c_ab = m_b k_ab (both
+    directions of each pair), on the rows thread t writes (``forces.thread_rows``)."""
     for t in nb.prange(pair_count.size):
-        cnt[t, :n] = 0
-        for q in range(pair_count[t]):
-            cnt[t, pair_i[t, q]] += 1
-            cnt[t, pair_j[t, q]] += 1
-
-
-@nb.njit(parallel=True, cache=True)
-def _fill_rows(pair_i, pair_j, pair_k, pair_count, mass, cnt, cols, wts):
-    for t in nb.prange(pair_count.size):
-        fill = cnt[t]  # row starts of this thread's entries (from ``sort_pairs``)
-        for q in range(pair_count[t]):
-            a = pair_i[t, q]
-            b = pair_j[t, q]
+        at = acc[t]
+        lo, hi = thread_rows(start, split, t, ncx, ncz)
+        at[lo:hi] = 0.0
+        if periodic and split[t + 1] == ncx:
+            at[0:start[ncz]] = 0.0
+        for q in range(np.uint64(pair_count[t])):
+            a = np.uint64(pair_i[t, q])
+            b = np.uint64(pair_j[t, q])
             k = pair_k[t, q]
-            cols[fill[a]] = b
-            wts[fill[a]] = mass[b] * k
-            fill[a] += 1
-            cols[fill[b]] = a
-            wts[fill[b]] = mass[a] * k
-            fill[b] += 1
+            wa = mass[b] * k
+            wb = mass[a] * k
+            at[a, 0] += wa * yx[b]
+            at[a, 1] += wa * yz[b]
+            at[b, 0] += wb * yx[a]
+            at[b, 1] += wb * yz[a]
+
+
+@nb.njit(parallel=True, cache=True)
+def _sum_shares(acc, start, split, ncx, ncz, periodic, sx, sz, n):
+    """s = the threads' shares summed over the rows each wrote, 0 elsewhere."""
+    for a in nb.prange(n):
+        sx[a] = sz[a] = 0.0
+    for t in range(acc.shape[0]):
+        lo, hi = thread_rows(start, split, t, ncx, ncz)
+        for a in nb.prange(lo, hi):
+            sx[a] += acc[t, a, 0]
+            sz[a] += acc[t, a, 1]
+        if periodic and split[t + 1] == ncx and split[t] > 0:
+            for a in nb.prange(start[ncz]):
+                sx[a] += acc[t, a, 0]
+                sz[a] += acc[t, a, 1]
 
 
 @nb.njit(cache=True)
-def _row_offsets(cnt, ptr, n):
-    """ptr[a] = entries before row a; cnt[t, a] becomes thread t's first slot in row a."""
-    nt = cnt.shape[0]
-    total = 0
-    for a in range(n):
-        ptr[a] = total
-        for t in range(nt):
-            c = cnt[t, a]
-            cnt[t, a] = total
-            total += c
-    ptr[n] = total
-
-
-def sort_pairs(pair_i, pair_j, pair_k, pair_count, mass, n, rows: Rows) -> None:
-    """Arrange the pair loop's per-thread pair lists (``forces.PairList``) into ``rows``."""
-    _count_rows(pair_i, pair_j, pair_count, rows.per_thread, n)
-    _row_offsets(rows.per_thread, rows.ptr, n)
-    _fill_rows(pair_i, pair_j, pair_k, pair_count, mass, rows.per_thread, rows.cols, rows.wts)
-
-
-@nb.njit(inline="always", cache=True)
-def _row_sums(ptr, cols, wts, px, pz, a):
-    """Row a's off-diagonal sums (sum_b c_ab p_b) of both components."""
-    sx = 0.0
-    sz = 0.0
-    for q in range(ptr[a], ptr[a + 1]):
-        b = cols[q]
-        sx += wts[q] * px[b]
-        sz += wts[q] * pz[b]
-    return sx, sz
+def offdiagonal_products(op, yx, yz, sx, sz, n):
+    """(sx, sz)_a = sum_b c_ab (yx, yz)_b over the listed fluid pairs, for every row of [0, n)
+    (0 on rows with none: walls); ``op`` from ``operator``."""
+    pair_i, pair_j, pair_k, pair_count, mass, _, acc, start, split, ncx, ncz, periodic = op
+    _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
+                        periodic)
+    _sum_shares(acc, start, split, ncx, ncz, periodic, sx, sz, n)
 
 
 @nb.njit(parallel=True, cache=True)
-def _apply(ptr, cols, wts, diag, mass, kind, dt, px, pz, yx, yz, n):
-    """y = A p, A = M (I + dt C) on the fluid rows (module docstring)."""
+def _scaled_system(mass, diag, kind, dt, px, pz, sx, sz, yx, yz, n):
+    """y = M ((1 + dt diag) p - dt s) on the fluid rows, s the off-diagonal products of p."""
     for a in nb.prange(n):
         if kind[a] != 0:
             continue
-        sx, sz = _row_sums(ptr, cols, wts, px, pz, a)
-        s = 1.0 + dt * diag[a]
-        yx[a] = mass[a] * (s * px[a] - dt * sx)
-        yz[a] = mass[a] * (s * pz[a] - dt * sz)
+        d = 1.0 + dt * diag[a]
+        yx[a] = mass[a] * (d * px[a] - dt * sx[a])
+        yz[a] = mass[a] * (d * pz[a] - dt * sz[a])
+
+
+@nb.njit(cache=True)
+def _apply(op, kind, dt, px, pz, yx, yz, sx, sz, n):
+    """y = A p, A = M (I + dt C) on the fluid rows (module docstring); (sx, sz): scratch."""
+    offdiagonal_products(op, px, pz, sx, sz, n)
+    _scaled_system(op[4], op[5], kind, dt, px, pz, sx, sz, yx, yz, n)
 
 
 @nb.njit(parallel=True, cache=True)
@@ -162,19 +157,19 @@ def _dot(kind, ax, bx, az, bz, n):
 
 
 @nb.njit(parallel=True, cache=True)
-def solve(ptr, cols, wts, diag, mass, kind, dt, ax, az, cx, cz, n, tol, max_iterations, work):
+def solve(op, kind, dt, ax, az, cx, cz, n, tol, max_iterations, work):
     """Overwrite (ax, az) of the fluid rows of [0, n) with delta / dt, delta solving
     M (I + dt C) delta = M dt a by Jacobi-preconditioned CG, for each component, from
     delta0 = dt (a + c); (cx, cz): c, the implicit correction delta / dt - a of the previous
-    step (zeros for none), overwritten with this step's. ptr, cols, wts: the off-diagonal by
-    rows (``Rows``); ``diag``: sum_b c_ab per particle; ``work``: scratch of shape
-    (WORK_ROWS, >= n).
+    step (zeros for none), overwritten with this step's. ``op``: C (``operator``);
+    ``work``: scratch of shape (WORK_ROWS, >= n).
 
     Returns (iterations, largest relative residual); the residual exceeds ``tol`` when
     ``max_iterations`` did not suffice."""
-    dx, dz, rx, rz, zx, zz, px, pz, qx, qz, pre = (work[0], work[1], work[2], work[3], work[4],
-                                                   work[5], work[6], work[7], work[8], work[9],
-                                                   work[10])
+    dx, dz, rx, rz, zx, zz, px, pz, qx, qz, pre, sx, sz = (work[0], work[1], work[2], work[3], work[4],
+                                                           work[5], work[6], work[7], work[8], work[9],
+                                                           work[10], work[11], work[12])
+    mass, diag = op[4], op[5]
     bbx = 0.0
     bbz = 0.0
     for a in nb.prange(n):
@@ -187,7 +182,7 @@ def solve(ptr, cols, wts, diag, mass, kind, dt, ax, az, cx, cz, n, tol, max_iter
         else:
             dx[a] = dz[a] = pre[a] = px[a] = pz[a] = 0.0
     # r = b - A delta0 with b = M dt a
-    _apply(ptr, cols, wts, diag, mass, kind, dt, dx, dz, qx, qz, n)
+    _apply(op, kind, dt, dx, dz, qx, qz, sx, sz, n)
     for a in nb.prange(n):
         if kind[a] == 0:
             rx[a] = mass[a] * dt * ax[a] - qx[a]
@@ -202,7 +197,7 @@ def solve(ptr, cols, wts, diag, mass, kind, dt, ax, az, cx, cz, n, tol, max_iter
     rrx, rrz = _dot(kind, rx, rx, rz, rz, n)
     it = 0
     while it < max_iterations and (rrx > limx or rrz > limz):
-        _apply(ptr, cols, wts, diag, mass, kind, dt, px, pz, qx, qz, n)
+        _apply(op, kind, dt, px, pz, qx, qz, sx, sz, n)
         pqx, pqz = _dot(kind, px, qx, pz, qz, n)
         alx = rzx / pqx if rrx > limx and pqx > 0.0 else 0.0
         alz = rzz / pqz if rrz > limz and pqz > 0.0 else 0.0
@@ -296,58 +291,16 @@ def eigenvalue_bound(diag, kind, n: int) -> float:
     return 2.0 * float(_largest_diagonal(diag, kind, n))
 
 
-SUBSTEP_WORK_ROWS = 6
-
-
-def substep_accumulators(threads: int, n: int) -> np.ndarray:
-    """Per-thread scratch of ``substep``: each thread's share of C's off-diagonal products."""
-    return np.zeros((threads, n, 2))
-
-
 @nb.njit(parallel=True, cache=True)
-def _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
-                        periodic):
-    """acc[t, a] = sum over thread t's listed pairs (a, b) of c_ab y_b, c_ab = m_b k_ab (both
-    directions of each pair), on the rows thread t writes (``forces.thread_rows``)."""
-    for t in nb.prange(pair_count.size):
-        at = acc[t]
-        lo, hi = thread_rows(start, split, t, ncx, ncz)
-        at[lo:hi] = 0.0
-        if periodic and split[t + 1] == ncx:
-            at[0:start[ncz]] = 0.0
-        for q in range(np.uint64(pair_count[t])):
-            a = np.uint64(pair_i[t, q])
-            b = np.uint64(pair_j[t, q])
-            k = pair_k[t, q]
-            wa = mass[b] * k
-            wb = mass[a] * k
-            at[a, 0] += wa * yx[b]
-            at[a, 1] += wa * yz[b]
-            at[b, 0] += wb * yx[a]
-            at[b, 1] += wb * yz[a]
-
-
-@nb.njit(parallel=True, cache=True)
-def _rkc_stage(acc, start, split, ncx, ncz, periodic, diag, kind, ax, az, y1x, y1z, y2x, y2z,
-               outx, outz, mu, nu, mut_dt, n):
+def _rkc_stage(diag, kind, ax, az, y1x, y1z, y2x, y2z, sx, sz, outx, outz, mu, nu, mut_dt, n):
     """out = mu y1 + nu y2 + mut dt (a - C y1) on the fluid rows, 0 elsewhere (Y_0 = 0), with
-    (C y1)_a = diag_a y1_a - sum_b c_ab y1_b and the off-diagonal sums from ``acc``."""
+    (C y1)_a = diag_a y1_a - s_a, s the off-diagonal products of y1."""
     for a in nb.prange(n):
         if kind[a] == 0:
-            outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - diag[a] * y1x[a])
-            outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - diag[a] * y1z[a])
+            outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - diag[a] * y1x[a] + sx[a])
+            outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - diag[a] * y1z[a] + sz[a])
         else:
             outx[a] = outz[a] = 0.0
-    nt = acc.shape[0]
-    for t in range(nt):  # listed pairs are fluid pairs: other rows of acc hold zeros
-        lo, hi = thread_rows(start, split, t, ncx, ncz)
-        for a in nb.prange(lo, hi):
-            outx[a] += mut_dt * acc[t, a, 0]
-            outz[a] += mut_dt * acc[t, a, 1]
-        if periodic and split[t + 1] == ncx and split[t] > 0:
-            for a in nb.prange(start[ncz]):
-                outx[a] += mut_dt * acc[t, a, 0]
-                outz[a] += mut_dt * acc[t, a, 1]
 
 
 @nb.njit(parallel=True, cache=True)
@@ -370,24 +323,22 @@ def _take_increment(kind, dx, dz, ax, az, inv_dt, n):
             az[a] = dz[a] * inv_dt
 
 
-def substep(pairs, cl, split, diag, mass, kind, dt: float, ax, az, n: int, work, acc) -> int:
+def substep(op, kind, dt: float, ax, az, n: int, work) -> int:
     """Overwrite (ax, az) of the fluid rows of [0, n) with delta / dt, delta integrating
     d delta / dt = a - C delta from 0 over dt (the laminar term at v^n + delta, the rest at
     the evaluation) by first-order RKC with as many stages as ``rkc_stages`` asks for dt
-    times ``eigenvalue_bound``: explicit stages, each one product with C, summed over the
-    pair loop's lists (``forces.PairList`` ``pairs``, thread t's pairs on the rows it writes:
-    ``cells.CellList`` cl, column ``split``) into the per-thread ``acc``
-    (``substep_accumulators``); ``work``: scratch of shape (SUBSTEP_WORK_ROWS, >= n).
-    Returns the stages."""
+    times ``eigenvalue_bound``: explicit stages, each one product with C (``op``, from
+    ``operator``); ``work``: scratch of shape (SUBSTEP_WORK_ROWS, >= n). Returns the stages."""
+    diag = op[5]
     s = rkc_stages(dt * eigenvalue_bound(diag, kind, n))
     _, mu, nu, mut = rkc_coefficients(s)
     ys = [(work[0], work[1]), (work[2], work[3]), (work[4], work[5])]  # Y_{j-2}, Y_{j-1}, Y_j
+    sx, sz = work[6], work[7]
     _first_stage(kind, ax, az, *ys[0], *ys[1], mut[1] * dt, n)
-    grid = (cl.start, split, cl.ncx, cl.ncz, cl.periodic)
     for j in range(2, s + 1):
         (y2x, y2z), (y1x, y1z), (ox, oz) = ys
-        _offdiagonal_shares(*pairs, mass, y1x, y1z, acc, *grid)
-        _rkc_stage(acc, *grid, diag, kind, ax, az, y1x, y1z, y2x, y2z, ox, oz, mu[j], nu[j], mut[j] * dt, n)
+        offdiagonal_products(op, y1x, y1z, sx, sz, n)
+        _rkc_stage(diag, kind, ax, az, y1x, y1z, y2x, y2z, sx, sz, ox, oz, mu[j], nu[j], mut[j] * dt, n)
         ys = [ys[1], ys[2], ys[0]]
     _take_increment(kind, *ys[1], ax, az, 1.0 / dt, n)
     return s

@@ -120,12 +120,10 @@ class Simulation:
         # implicit viscosity: the pair loop's list of fluid pairs, CG scratch
         cap = implicit.pair_capacity(self.n, s.ch, self.nthreads) if self.implicit else 0
         self.pairs = forces.pair_list(self.nthreads, cap)
-        if self.implicit and self.substeps:
-            self.substep_acc = implicit.substep_accumulators(self.nthreads, self.n)
-            self.solver_work = np.zeros((implicit.SUBSTEP_WORK_ROWS, self.n))
-        elif self.implicit:
-            self.rows = implicit.rows_for(self.nthreads, self.n, cap)
-            self.solver_work = np.zeros((implicit.WORK_ROWS, self.n))
+        if self.implicit:
+            self.product_shares = implicit.product_shares(self.nthreads, self.n)
+            rows = implicit.SUBSTEP_WORK_ROWS if self.substeps else implicit.WORK_ROWS
+            self.solver_work = np.zeros((rows, self.n))
         cg = self.implicit and not self.substeps
         self.implicit_cx = np.zeros(self.n if cg else 1)
         self.implicit_cz = np.zeros(self.n if cg else 1)
@@ -210,8 +208,6 @@ class Simulation:
             # more pairs than the list holds: widen it and evaluate again
             cap = int(1.25 * self.pairs.count.max())
             self.pairs = forces.pair_list(self.nthreads, cap)
-            if not self.substeps:
-                self.rows = implicit.rows_for(self.nthreads, self.n, cap)
             self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.cells,
                                                s.gravity[0], s.gravity[1], self.out, self.n)
@@ -228,22 +224,26 @@ class Simulation:
             self._correct_density()
         return ""
 
+    def viscous_operator(self) -> tuple:
+        """The laminar operator C of the last evaluation (``implicit.operator``)."""
+        return implicit.operator(self.pairs, self.cells, self.split, self.out[self.nq - 1], self.mass,
+                                 self.product_shares)
+
     def _solve_viscous(self, dt: float) -> str:
         """Replace the evaluation's accelerations by (v^{n+1} - v^n) / dt of backward Euler in
         the laminar term (or, sub-stepped, of its RKC integration over the step); the force
         limit of the next step takes their maximum."""
         o = self.out
         n = self.n_active
+        op = self.viscous_operator()
         if self.substeps:  # RKC stages instead of the backward-Euler solve
-            self.rkc_stages += implicit.substep(self.pairs, self.cells, self.split, o[self.nq - 1], self.mass,
-                                                self.kind, dt, o[forces.AX], o[forces.AZ], n,
-                                                self.solver_work, self.substep_acc)
+            self.rkc_stages += implicit.substep(op, self.kind, dt, o[forces.AX], o[forces.AZ], n,
+                                                self.solver_work)
             self.amax = float(implicit.largest_fluid_acceleration(o[forces.AX], o[forces.AZ], self.kind, n))
             return ""
-        implicit.sort_pairs(*self.pairs[:3], self.pairs.count, self.mass, n, self.rows)
-        it, res = implicit.solve(*self.rows[:3], o[self.nq - 1], self.mass, self.kind, dt, o[forces.AX],
-                                 o[forces.AZ], self.implicit_cx, self.implicit_cz, n, implicit.TOLERANCE,
-                                 implicit.MAX_ITERATIONS, self.solver_work)
+        it, res = implicit.solve(op, self.kind, dt, o[forces.AX], o[forces.AZ], self.implicit_cx,
+                                 self.implicit_cz, n, implicit.TOLERANCE, implicit.MAX_ITERATIONS,
+                                 self.solver_work)
         self.solver_iterations += it
         if not res <= implicit.TOLERANCE:
             return (f"implicit viscous solve: relative residual {res:.3g} after {it} iterations "

@@ -47,21 +47,9 @@ def dense_operator(sim):
     return C, rows, listed
 
 
-def rows_operator(sim, rows):
-    """C as the arranged rows (``implicit.Rows``) hold it, dense over the fluid rows."""
-    pos = np.full(sim.n, -1)
-    pos[rows] = np.arange(rows.size)
-    C = np.diag(sim.out[sim.nq - 1][rows])
-    ptr, cols, wts = sim.rows.ptr, sim.rows.cols, sim.rows.wts
-    for a in rows:
-        for q in range(ptr[a], ptr[a + 1]):
-            C[pos[a], pos[cols[q]]] -= wts[q]
-    return C
-
-
 def random_system(seed):
     """The jittered channel's C (dense), its fluid rows, and random accelerations (ax, az) on
-    them, with the pair list arranged into the rows that the update and the solver read."""
+    them."""
     sc, sim = jittered_couette()
     C, rows, _ = dense_operator(sim)
     rng = np.random.default_rng(seed)
@@ -69,7 +57,6 @@ def random_system(seed):
     az = np.zeros(sim.n)
     ax[rows] = rng.normal(0.0, 1.0, rows.size)
     az[rows] = rng.normal(0.0, 1.0, rows.size)
-    implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, sim.n_active, sim.rows)
     return sc, sim, C, rows, ax, az
 
 
@@ -97,21 +84,36 @@ def test_the_pair_list_holds_every_pair_once_and_the_weighted_operator_is_symmet
     assert np.abs(wall_share[~next_to_wall]).max() <= 1e-12 * C.diagonal().max()
 
 
+def test_the_products_over_the_pair_lists_are_the_operators_off_diagonal():
+    """implicit.offdiagonal_products (every thread's share of every listed pair, both
+    directions, summed over the rows it writes, the periodic wrap included) against the dense
+    C's off-diagonal: s = (diag(C) - C) y on the fluid rows, 0 on the walls."""
+    sc, sim, C, rows, ax, az = random_system(4)
+    assert sim.split.size - 1 == sim.nthreads and sim.cells.periodic
+    off = np.diag(C.diagonal()) - C
+    sx, sz = np.full(sim.n, np.nan), np.full(sim.n, np.nan)
+    implicit.offdiagonal_products(sim.viscous_operator(), ax, az, sx, sz, sim.n_active)
+    walls = sim.kind[:sim.n_active] != 0
+    scale = np.abs(off).sum(1).max() * np.abs(ax).max()
+    assert np.abs(sx[rows] - off @ ax[rows]).max() <= 1e-13 * scale
+    assert np.abs(sz[rows] - off @ az[rows]).max() <= 1e-13 * scale
+    assert not sx[:sim.n_active][walls].any() and not sz[:sim.n_active][walls].any()
+
+
 @pytest.mark.parametrize("dt_over_dt3", [0.2, 50.0])
 def test_conjugate_gradients_solve_the_backward_euler_system(dt_over_dt3):
     """(I + dt C) delta = dt a, solved by CG to a relative residual of 1e-10, against a dense
     solve of the same matrix, at a step below and far above the explicit viscous limit."""
     sc, sim, C, rows, ax, az = random_system(2)
     dt = dt_over_dt3 * sc.h ** 2 / sc.nu
-    assert np.abs(rows_operator(sim, rows) - C).max() <= 1e-14 * np.abs(C).max()  # the rows hold C
     A = np.eye(rows.size) + dt * C
     expect_x = np.linalg.solve(A, dt * ax[rows]) / dt
     expect_z = np.linalg.solve(A, dt * az[rows]) / dt
     cx = np.zeros(sim.n)
     cz = np.zeros(sim.n)
     ax0, az0 = ax.copy(), az.copy()
-    it, res = implicit.solve(*sim.rows[:3], sim.out[sim.nq - 1], sim.mass, sim.kind, dt, ax, az, cx, cz,
-                             sim.n_active, 1e-10, implicit.MAX_ITERATIONS, sim.solver_work)
+    it, res = implicit.solve(sim.viscous_operator(), sim.kind, dt, ax, az, cx, cz, sim.n_active, 1e-10,
+                             implicit.MAX_ITERATIONS, sim.solver_work)
     assert res <= 1e-10 and 0 < it < implicit.MAX_ITERATIONS
     scale = np.abs(expect_x).max()
     assert np.abs(ax[rows] - expect_x).max() < 1e-8 * scale
@@ -134,12 +136,11 @@ def test_conjugate_gradients_started_from_the_last_correction_reach_the_same_sol
     a_last[:, rows] = rng.normal(0.0, 1.0, (2, rows.size))
     a_now = a_last.copy()
     a_now[:, rows] += rng.normal(0.0, 0.01, (2, rows.size))
-    implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, sim.n_active, sim.rows)
 
     def solve(a, c, tol):
         ax, az = a.copy()
-        it, res = implicit.solve(*sim.rows[:3], sim.out[sim.nq - 1], sim.mass, sim.kind, dt, ax, az, *c,
-                                 sim.n_active, tol, implicit.MAX_ITERATIONS, sim.solver_work)
+        it, res = implicit.solve(sim.viscous_operator(), sim.kind, dt, ax, az, *c, sim.n_active, tol,
+                                 implicit.MAX_ITERATIONS, sim.solver_work)
         assert res <= tol
         return np.array([ax, az]), it
 
@@ -279,9 +280,8 @@ def test_the_memory_estimate_covers_what_the_implicit_update_allocates(update):
     sim = Simulation(sc, build_particles(sc))
     substeps = update == "substepped"
     assert sim.substeps == substeps
-    held = sum(a.nbytes for a in sim.pairs) + sim.solver_work.nbytes
-    held += sim.substep_acc.nbytes if substeps else sum(a.nbytes for a in sim.rows)
-    slack = sim.nthreads * 1024 * (16 if substeps else 40)
+    held = sum(a.nbytes for a in sim.pairs) + sim.solver_work.nbytes + sim.product_shares.nbytes
+    slack = sim.nthreads * 1024 * 16
     estimate = sim.n * implicit.bytes_per_particle(sc.ch, substeps)
     assert held <= estimate + slack + 64
     assert held >= 0.9 * estimate
@@ -314,9 +314,8 @@ def test_the_substepped_update_is_runge_kutta_chebyshev_on_the_same_operator(dt_
     dt = dt_over_dt3 * sc.h ** 2 / sc.nu
     expect_x, s = rkc_dense(C, dt, ax[rows])
     expect_z, _ = rkc_dense(C, dt, az[rows])
-    stages = implicit.substep(sim.pairs, sim.cells, sim.split, sim.out[sim.nq - 1], sim.mass, sim.kind, dt,
-                              ax, az, sim.n_active, np.zeros((implicit.SUBSTEP_WORK_ROWS, sim.n)),
-                              implicit.substep_accumulators(sim.nthreads, sim.n))
+    stages = implicit.substep(sim.viscous_operator(), sim.kind, dt, ax, az, sim.n_active,
+                              np.zeros((implicit.SUBSTEP_WORK_ROWS, sim.n)))
     assert stages == s
     scale = np.abs(expect_x).max()
     assert np.abs(ax[rows] - expect_x).max() < 1e-9 * scale

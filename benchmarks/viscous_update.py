@@ -1,13 +1,15 @@
-"""The sub-stepped viscous update alone, of two solver trees, on the same arrays: ms per step.
+"""The implicit or sub-stepped viscous update alone, of two solver trees, on the same arrays: ms a step.
 
-Steps the paper case (examples/conveyor_fast.yaml's scheme, ``viscous_update: substepped``) at
---dp for --warmup steps with this tree, then calls each tree's whole sub-stepped update of the
-last step's evaluation (for OLD_TREE as its ``Simulation._solve_viscous`` runs it, with the
-arrangement of the pair list into rows if it has one; the same right-hand side, pair list and
-dt for both) --calls times, the order swapped every call, and prints the median ms of each,
-their ratio, and the largest difference of the two results over the largest |delta / dt|.
+Steps the paper case (examples/conveyor_fast.yaml's scheme, ``viscous_update: --update``) at
+--dp for --warmup steps with this tree, then calls each tree's whole update of the last
+step's evaluation (as its ``Simulation._solve_viscous`` runs it, with the arrangement of the
+pair list into rows if that tree has one; the same pair list, right-hand side and dt for
+both; CG from the explicit step, to the solver's tolerance) --calls times, the order swapped
+every call, and prints the median ms of each, their ratio, the stages or CG iterations, and
+the largest difference of the two results over the largest |delta / dt|.
 
-Usage: python benchmarks/substep.py OLD_TREE [--dp 0.00025] [--ch 1.8] [--threads 2] [--warmup 4] [--calls 20]
+Usage: python benchmarks/viscous_update.py OLD_TREE [--update substepped|implicit] [--dp 0.00025] [--ch 1.8]
+           [--threads 2] [--warmup 4] [--calls 20]
 """
 from __future__ import annotations
 
@@ -27,14 +29,14 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from pair_loop import import_tree  # noqa: E402
 
 
-def simulation(dp: float, ch: float, warmup: int):
+def simulation(dp: float, ch: float, update: str, warmup: int):
     from solver.build import build_particles
     from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
     from solver.scene import read_yaml
     from solver.simulation import Simulation
 
     d = read_yaml(ROOT / "examples" / "conveyor_fast.yaml")
-    d.update(dp=dp, ch=ch, viscous_update="substepped", start_depth="theory")
+    d.update(dp=dp, ch=ch, viscous_update=update, start_depth="theory")
     case = case_from_dict(d)
     scene = build_scene(case)
     parts = build_particles(scene)
@@ -59,6 +61,7 @@ def simulation(dp: float, ch: float, warmup: int):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("old_tree", type=Path)
+    ap.add_argument("--update", choices=["substepped", "implicit"], default="substepped")
     ap.add_argument("--dp", type=float, default=0.00025)
     ap.add_argument("--ch", type=float, default=1.8)
     ap.add_argument("--threads", type=int, default=2)
@@ -69,24 +72,33 @@ def main(argv=None):
     from solver import implicit
     import_tree(a.old_tree, "solver_old")
     old_implicit = importlib.import_module("solver_old.implicit")
-    sim, kept = simulation(a.dp, a.ch, a.warmup)
+    sim, kept = simulation(a.dp, a.ch, a.update, a.warmup)
     n, dt = sim.n_active, kept["dt"]
     diag = sim.out[sim.nq - 1]
     cap = sim.pairs.i.shape[1]
     old_rows = old_implicit.rows_for(sim.nthreads, sim.n, cap) if hasattr(old_implicit, "rows_for") else None
     old_work = np.zeros((max(old_implicit.WORK_ROWS, 6), sim.n))
-    new_work = np.zeros((implicit.SUBSTEP_WORK_ROWS, sim.n))
-    acc = implicit.substep_accumulators(sim.nthreads, sim.n)
+    cg = a.update == "implicit"
+    new_work = np.zeros((implicit.WORK_ROWS if cg else implicit.SUBSTEP_WORK_ROWS, sim.n))
     fluid = sim.kind[:n] == 0
+    tol, most = implicit.TOLERANCE, implicit.MAX_ITERATIONS
 
     def run_old(ax, az):
         old_implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, n, old_rows)
-        s = old_implicit.substep(*old_rows[:3], diag, sim.kind, dt, ax, az, n, old_work)
+        if cg:
+            zero = np.zeros((2, sim.n))
+            s = old_implicit.solve(*old_rows[:3], diag, sim.mass, sim.kind, dt, ax, az, *zero, n, tol, most,
+                                   old_work)[0]
+        else:
+            s = old_implicit.substep(*old_rows[:3], diag, sim.kind, dt, ax, az, n, old_work)
         return s, float(np.hypot(ax[:n][fluid], az[:n][fluid]).max(initial=0.0))
 
     def run_new(ax, az):
-        s = implicit.substep(sim.pairs, sim.cells, sim.split, diag, sim.mass, sim.kind, dt, ax, az, n,
-                             new_work, acc)
+        if cg:
+            zero = np.zeros((2, sim.n))
+            s = implicit.solve(sim.viscous_operator(), sim.kind, dt, ax, az, *zero, n, tol, most, new_work)[0]
+        else:
+            s = implicit.substep(sim.viscous_operator(), sim.kind, dt, ax, az, n, new_work)
         return s, float(implicit.largest_fluid_acceleration(ax, az, sim.kind, n))
 
     runs = {"old": run_old, "new": run_new}
@@ -104,8 +116,9 @@ def main(argv=None):
     sn, an, xn, zn = results["new"]
     scale = max(np.abs(xo).max(), np.abs(zo).max())
     diff = max(np.abs(xo - xn).max(), np.abs(zo - zn).max()) / scale
-    out = {"dp": a.dp, "ch": a.ch, "threads": a.threads, "particles": sim.n, "pairs": int(sim.pairs.count.sum()),
-           "stages": [so, sn], "old_ms": round(1e3 * float(np.median(times["old"])), 2),
+    out = {"update": a.update, "dp": a.dp, "ch": a.ch, "threads": a.threads, "particles": sim.n,
+           "pairs": int(sim.pairs.count.sum()),
+           "stages_or_iterations": [so, sn], "old_ms": round(1e3 * float(np.median(times["old"])), 2),
            "new_ms": round(1e3 * float(np.median(times["new"])), 2),
            "relative_difference": float(f"{diff:.2g}"), "amax_relative_difference": float(f"{abs(ao - an) / ao:.2g}")}
     out["new_over_old"] = round(out["new_ms"] / out["old_ms"], 3)
