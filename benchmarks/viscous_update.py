@@ -75,32 +75,41 @@ def main(argv=None):
     sim, kept = simulation(a.dp, a.ch, a.update, a.warmup)
     n, dt = sim.n_active, kept["dt"]
     diag = sim.out[sim.nq - 1]
-    cap = sim.pairs.i.shape[1]
-    old_rows = old_implicit.rows_for(sim.nthreads, sim.n, cap) if hasattr(old_implicit, "rows_for") else None
-    old_work = np.zeros((max(old_implicit.WORK_ROWS, 6), sim.n))
     cg = a.update == "implicit"
-    new_work = np.zeros((implicit.WORK_ROWS if cg else implicit.SUBSTEP_WORK_ROWS, sim.n))
     fluid = sim.kind[:n] == 0
     tol, most = implicit.TOLERANCE, implicit.MAX_ITERATIONS
 
-    def run_old(ax, az):
-        old_implicit.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, n, old_rows)
-        if cg:
-            zero = np.zeros((2, sim.n))
-            s = old_implicit.solve(*old_rows[:3], diag, sim.mass, sim.kind, dt, ax, az, *zero, n, tol, most,
-                                   old_work)[0]
-        else:
-            s = old_implicit.substep(*old_rows[:3], diag, sim.kind, dt, ax, az, n, old_work)
-        return s, float(np.hypot(ax[:n][fluid], az[:n][fluid]).max(initial=0.0))
+    def runner(impl):
+        """The whole update of ``impl`` (a solver tree's implicit module) on the kept step."""
+        if not hasattr(impl, "operator"):  # trees that arranged the pair list by rows first
+            return rows_runner(impl)
+        shares = impl.product_shares(sim.nthreads, sim.n)
+        work = np.zeros((impl.WORK_ROWS if cg else impl.SUBSTEP_WORK_ROWS, sim.n))
 
-    def run_new(ax, az):
-        if cg:
-            zero = np.zeros((2, sim.n))
-            s = implicit.solve(sim.viscous_operator(), sim.kind, dt, ax, az, *zero, n, tol, most, new_work)[0]
-        else:
-            s = implicit.substep(sim.viscous_operator(), sim.kind, dt, ax, az, n, new_work)
-        return s, float(implicit.largest_fluid_acceleration(ax, az, sim.kind, n))
+        def run(ax, az):
+            op = impl.operator(sim.pairs, sim.cells, sim.split, diag, sim.mass, shares)
+            if cg:
+                s = impl.solve(op, sim.kind, dt, ax, az, *np.zeros((2, sim.n)), n, tol, most, work)[0]
+            else:
+                s = impl.substep(op, sim.kind, dt, ax, az, n, work)
+            return s, float(np.sqrt(np.max(ax[:n][fluid] ** 2 + az[:n][fluid] ** 2, initial=0.0)))
+        return run
 
+    def rows_runner(impl):
+        rows = impl.rows_for(sim.nthreads, sim.n, sim.pairs.i.shape[1])
+        work = np.zeros((max(impl.WORK_ROWS, 6), sim.n))
+
+        def run(ax, az):
+            impl.sort_pairs(*sim.pairs[:3], sim.pairs.count, sim.mass, n, rows)
+            if cg:
+                s = impl.solve(*rows[:3], diag, sim.mass, sim.kind, dt, ax, az, *np.zeros((2, sim.n)), n, tol,
+                               most, work)[0]
+            else:
+                s = impl.substep(*rows[:3], diag, sim.kind, dt, ax, az, n, work)
+            return s, float(np.hypot(ax[:n][fluid], az[:n][fluid]).max(initial=0.0))
+        return run
+
+    run_old, run_new = runner(old_implicit), runner(implicit)
     runs = {"old": run_old, "new": run_new}
     times = {"old": [], "new": []}
     results = {}
