@@ -26,23 +26,30 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def capture(dp: float, ch: float, steps: int, systems: int):
-    """Step the case and keep the CG systems of its last ``systems`` steps: (the systems,
-    the belt speed, the simulation, its own ``_solve_viscous``)."""
-    from solver import forces
-    from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
+def paper_case_simulation(dp: float, ch: float, update: str):
+    """The paper case with examples/conveyor_fast.yaml's scheme and ``viscous_update: update``,
+    started at h_n with the lubrication film's velocity: (the simulation, the case)."""
     from solver.build import build_particles
+    from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
     from solver.scene import read_yaml
     from solver.simulation import Simulation
 
     d = read_yaml(ROOT / "examples" / "conveyor_fast.yaml")
-    d.update(dp=dp, ch=ch, viscous_update="implicit", start_depth="theory")
+    d.update(dp=dp, ch=ch, viscous_update=update, start_depth="theory")
     case = case_from_dict(d)
     scene = build_scene(case)
     parts = build_particles(scene)
     f = parts.kind == 0
     parts.u[f], parts.w[f] = lubrication_velocity(case, scene, parts.x[f], parts.z[f])
-    sim = Simulation(scene, parts)
+    return Simulation(scene, parts), case
+
+
+def capture(dp: float, ch: float, steps: int, systems: int):
+    """Step the case and keep the CG systems of its last ``systems`` steps: (the systems,
+    the belt speed, the simulation, its own ``_solve_viscous``)."""
+    from solver import forces
+
+    sim, case = paper_case_simulation(dp, ch, "implicit")
     kept: list[dict] = []
     original = sim._solve_viscous
 

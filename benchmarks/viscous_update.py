@@ -26,23 +26,13 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
+from cg_solve import paper_case_simulation  # noqa: E402
 from pair_loop import import_tree  # noqa: E402
 
 
 def simulation(dp: float, ch: float, update: str, warmup: int):
-    from solver.build import build_particles
-    from solver.conveyor import build_scene, case_from_dict, lubrication_velocity
-    from solver.scene import read_yaml
-    from solver.simulation import Simulation
-
-    d = read_yaml(ROOT / "examples" / "conveyor_fast.yaml")
-    d.update(dp=dp, ch=ch, viscous_update=update, start_depth="theory")
-    case = case_from_dict(d)
-    scene = build_scene(case)
-    parts = build_particles(scene)
-    f = parts.kind == 0
-    parts.u[f], parts.w[f] = lubrication_velocity(case, scene, parts.x[f], parts.z[f])
-    sim = Simulation(scene, parts)
+    """The paper case stepped ``warmup`` times, and its last evaluation's accelerations and dt."""
+    sim, _ = paper_case_simulation(dp, ch, update)
     kept = {}
     original = sim._solve_viscous
 
