@@ -489,17 +489,12 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
 
 
 @nb.njit(parallel=True, cache=True)
-def reduce_accumulators(acc, kind, split, cl, gx, gz, out, n):
-    """out[q, i] = sum_t acc[t, i, q] over the threads that wrote particle i (thread t
-    writes the particles of its columns and of the next column); gravity added to fluid
-    accelerations.
-
-    Returns max |a| over fluid particles (for dt1).
-    """
-    start, ncx, ncz, periodic = cl.start, cl.ncx, cl.ncz, cl.periodic
+def sum_thread_rows(acc, start, split, ncx, ncz, periodic, out, n):
+    """out[q, i] = sum_t acc[t, i, q] over the threads that wrote particle i of [0, n) (thread
+    t writes the particles of its columns and of the next column, ``thread_rows``; with a
+    periodic x the last thread's next column is column 0), 0 where none did."""
     nt = acc.shape[0]
     nq = acc.shape[2]
-    amax = np.zeros(n)
     for i in nb.prange(n):
         for q in range(nq):
             out[q, i] = 0.0
@@ -512,6 +507,17 @@ def reduce_accumulators(acc, kind, split, cl, gx, gz, out, n):
             for i in nb.prange(start[ncz]):
                 for q in range(nq):
                     out[q, i] += acc[t, i, q]
+
+
+@nb.njit(parallel=True, cache=True)
+def reduce_accumulators(acc, kind, split, cl, gx, gz, out, n):
+    """out = the threads' pair sums (``sum_thread_rows``), gravity added to fluid
+    accelerations.
+
+    Returns max |a| over fluid particles (for dt1).
+    """
+    sum_thread_rows(acc, cl.start, split, cl.ncx, cl.ncz, cl.periodic, out, n)
+    amax = np.zeros(n)
     for i in nb.prange(n):
         if kind[i] == 0:
             out[0, i] += gx

@@ -30,7 +30,8 @@ The pair loop lists the fluid pairs with k_ab = c_ab / m_b (``forces.PairList``,
 each pair once) and sums the diagonal sum_b c_ab. Every product with C (CG's and the
 sub-stepped update's) runs over those per-thread lists: thread t adds c_ab y_b to row a and
 c_ba y_a to row b of its own accumulator, on the rows it writes (``forces.thread_rows``), and
-the threads' shares are summed (``offdiagonal_products``). The list is never arranged by rows.
+the threads' shares are summed as the pair loop's are (``offdiagonal_products``,
+``forces.sum_thread_rows``). The list is never arranged by rows.
 """
 from __future__ import annotations
 
@@ -39,7 +40,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import thread_rows
+from .forces import sum_thread_rows, thread_rows
 
 TOLERANCE = 1.0e-6  # CG stops when |residual| <= TOLERANCE |right-hand side| (2-norm, each component)
 MAX_ITERATIONS = 1000
@@ -101,30 +102,14 @@ def _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, s
             at[b, 1] += wb * yz[a]
 
 
-@nb.njit(parallel=True, cache=True)
-def _sum_shares(acc, start, split, ncx, ncz, periodic, sx, sz, n):
-    """s = the threads' shares summed over the rows each wrote, 0 elsewhere."""
-    for a in nb.prange(n):
-        sx[a] = sz[a] = 0.0
-    for t in range(acc.shape[0]):
-        lo, hi = thread_rows(start, split, t, ncx, ncz)
-        for a in nb.prange(lo, hi):
-            sx[a] += acc[t, a, 0]
-            sz[a] += acc[t, a, 1]
-        if periodic and split[t + 1] == ncx and split[t] > 0:
-            for a in nb.prange(start[ncz]):
-                sx[a] += acc[t, a, 0]
-                sz[a] += acc[t, a, 1]
-
-
 @nb.njit(cache=True)
-def offdiagonal_products(op, yx, yz, sx, sz, n):
-    """(sx, sz)_a = sum_b c_ab (yx, yz)_b over the listed fluid pairs, for every row of [0, n)
-    (0 on rows with none: walls); ``op`` from ``operator``."""
+def offdiagonal_products(op, yx, yz, s, n):
+    """s[:, a] = sum_b c_ab (yx, yz)_b over the listed fluid pairs, for every row of [0, n)
+    (0 on rows with none: walls); ``op`` from ``operator``, ``s`` of shape (2, >= n)."""
     pair_i, pair_j, pair_k, pair_count, mass, _, acc, start, split, ncx, ncz, periodic = op
     _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
                         periodic)
-    _sum_shares(acc, start, split, ncx, ncz, periodic, sx, sz, n)
+    sum_thread_rows(acc, start, split, ncx, ncz, periodic, s, n)
 
 
 @nb.njit(parallel=True, cache=True)
@@ -139,10 +124,10 @@ def _scaled_system(mass, diag, kind, dt, px, pz, sx, sz, yx, yz, n):
 
 
 @nb.njit(cache=True)
-def _apply(op, kind, dt, px, pz, yx, yz, sx, sz, n):
-    """y = A p, A = M (I + dt C) on the fluid rows (module docstring); (sx, sz): scratch."""
-    offdiagonal_products(op, px, pz, sx, sz, n)
-    _scaled_system(op[4], op[5], kind, dt, px, pz, sx, sz, yx, yz, n)
+def _apply(op, kind, dt, px, pz, yx, yz, s, n):
+    """y = A p, A = M (I + dt C) on the fluid rows (module docstring); s: scratch (2, >= n)."""
+    offdiagonal_products(op, px, pz, s, n)
+    _scaled_system(op[4], op[5], kind, dt, px, pz, s[0], s[1], yx, yz, n)
 
 
 @nb.njit(parallel=True, cache=True)
@@ -166,9 +151,10 @@ def solve(op, kind, dt, ax, az, cx, cz, n, tol, max_iterations, work):
 
     Returns (iterations, largest relative residual); the residual exceeds ``tol`` when
     ``max_iterations`` did not suffice."""
-    dx, dz, rx, rz, zx, zz, px, pz, qx, qz, pre, sx, sz = (work[0], work[1], work[2], work[3], work[4],
-                                                           work[5], work[6], work[7], work[8], work[9],
-                                                           work[10], work[11], work[12])
+    dx, dz, rx, rz, zx, zz, px, pz, qx, qz, pre = (work[0], work[1], work[2], work[3], work[4],
+                                                   work[5], work[6], work[7], work[8], work[9],
+                                                   work[10])
+    s = work[11:13]  # the off-diagonal products
     mass, diag = op[4], op[5]
     bbx = 0.0
     bbz = 0.0
@@ -182,7 +168,7 @@ def solve(op, kind, dt, ax, az, cx, cz, n, tol, max_iterations, work):
         else:
             dx[a] = dz[a] = pre[a] = px[a] = pz[a] = 0.0
     # r = b - A delta0 with b = M dt a
-    _apply(op, kind, dt, dx, dz, qx, qz, sx, sz, n)
+    _apply(op, kind, dt, dx, dz, qx, qz, s, n)
     for a in nb.prange(n):
         if kind[a] == 0:
             rx[a] = mass[a] * dt * ax[a] - qx[a]
@@ -197,7 +183,7 @@ def solve(op, kind, dt, ax, az, cx, cz, n, tol, max_iterations, work):
     rrx, rrz = _dot(kind, rx, rx, rz, rz, n)
     it = 0
     while it < max_iterations and (rrx > limx or rrz > limz):
-        _apply(op, kind, dt, px, pz, qx, qz, sx, sz, n)
+        _apply(op, kind, dt, px, pz, qx, qz, s, n)
         pqx, pqz = _dot(kind, px, qx, pz, qz, n)
         alx = rzx / pqx if rrx > limx and pqx > 0.0 else 0.0
         alz = rzz / pqz if rrz > limz and pqz > 0.0 else 0.0
@@ -333,12 +319,13 @@ def substep(op, kind, dt: float, ax, az, n: int, work) -> int:
     s = rkc_stages(dt * eigenvalue_bound(diag, kind, n))
     _, mu, nu, mut = rkc_coefficients(s)
     ys = [(work[0], work[1]), (work[2], work[3]), (work[4], work[5])]  # Y_{j-2}, Y_{j-1}, Y_j
-    sx, sz = work[6], work[7]
+    s_off = work[6:8]  # the off-diagonal products
     _first_stage(kind, ax, az, *ys[0], *ys[1], mut[1] * dt, n)
     for j in range(2, s + 1):
         (y2x, y2z), (y1x, y1z), (ox, oz) = ys
-        offdiagonal_products(op, y1x, y1z, sx, sz, n)
-        _rkc_stage(diag, kind, ax, az, y1x, y1z, y2x, y2z, sx, sz, ox, oz, mu[j], nu[j], mut[j] * dt, n)
+        offdiagonal_products(op, y1x, y1z, s_off, n)
+        _rkc_stage(diag, kind, ax, az, y1x, y1z, y2x, y2z, s_off[0], s_off[1], ox, oz, mu[j], nu[j],
+                   mut[j] * dt, n)
         ys = [ys[1], ys[2], ys[0]]
     _take_increment(kind, *ys[1], ax, az, 1.0 / dt, n)
     return s

@@ -86,13 +86,13 @@ def test_the_pair_list_holds_every_pair_once_and_the_weighted_operator_is_symmet
 
 def test_the_products_over_the_pair_lists_are_the_operators_off_diagonal():
     """implicit.offdiagonal_products (every thread's share of every listed pair, both
-    directions, summed over the rows it writes, the periodic wrap included) against the dense
+    directions, summed over the rows it writes, the periodic wrap included, by forces.sum_thread_rows) against the dense
     C's off-diagonal: s = (diag(C) - C) y on the fluid rows, 0 on the walls."""
     sc, sim, C, rows, ax, az = random_system(4)
     assert sim.split.size - 1 == sim.nthreads and sim.cells.periodic
     off = np.diag(C.diagonal()) - C
-    sx, sz = np.full(sim.n, np.nan), np.full(sim.n, np.nan)
-    implicit.offdiagonal_products(sim.viscous_operator(), ax, az, sx, sz, sim.n_active)
+    sx, sz = products = np.full((2, sim.n), np.nan)
+    implicit.offdiagonal_products(sim.viscous_operator(), ax, az, products, sim.n_active)
     walls = sim.kind[:sim.n_active] != 0
     scale = np.abs(off).sum(1).max() * np.abs(ax).max()
     assert np.abs(sx[rows] - off @ ax[rows]).max() <= 1e-13 * scale
