@@ -35,6 +35,7 @@ the threads' shares are summed as the pair loop's are (``offdiagonal_products``,
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numba as nb
@@ -83,23 +84,39 @@ def operator(pairs, cl, split, diag, mass, shares) -> tuple:
 def _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
                         periodic):
     """acc[t, a] = sum over thread t's listed pairs (a, b) of c_ab y_b, c_ab = m_b k_ab (both
-    directions of each pair), on the rows thread t writes (``forces.thread_rows``)."""
+    directions of each pair), on the rows thread t writes (``forces.thread_rows``). Row a's
+    share is summed in registers over each run of consecutive pairs with the same a (the pair
+    loop lists a particle's pairs together) and added once per run."""
     for t in nb.prange(pair_count.size):
         at = acc[t]
         lo, hi = thread_rows(start, split, t, ncx, ncz)
         at[lo:hi] = 0.0
         if periodic and split[t + 1] == ncx:
             at[0:start[ncz]] = 0.0
-        for q in range(np.uint64(pair_count[t])):
-            a = np.uint64(pair_i[t, q])
+        count = np.uint64(pair_count[t])
+        if count == 0:
+            continue
+        a = np.uint64(pair_i[t, 0])
+        ma, yax, yaz = mass[a], yx[a], yz[a]
+        sx = sz = 0.0
+        for q in range(count):
+            i = np.uint64(pair_i[t, q])
+            if i != a:  # a new run: add the last one's sum to its row
+                at[a, 0] += sx
+                at[a, 1] += sz
+                a = i
+                ma, yax, yaz = mass[a], yx[a], yz[a]
+                sx = sz = 0.0
             b = np.uint64(pair_j[t, q])
             k = pair_k[t, q]
             wa = mass[b] * k
-            wb = mass[a] * k
-            at[a, 0] += wa * yx[b]
-            at[a, 1] += wa * yz[b]
-            at[b, 0] += wb * yx[a]
-            at[b, 1] += wb * yz[a]
+            wb = ma * k
+            sx += wa * yx[b]
+            sz += wa * yz[b]
+            at[b, 0] += wb * yax
+            at[b, 1] += wb * yaz
+        at[a, 0] += sx
+        at[a, 1] += sz
 
 
 @nb.njit(cache=True)
@@ -234,13 +251,15 @@ def rkc_stages(z: float, damping: float = RKC_DAMPING) -> int:
     return s
 
 
+@functools.lru_cache(maxsize=64)
 def rkc_coefficients(s: int, damping: float = RKC_DAMPING):
     """(beta, mu, nu, mut) of s-stage first-order RKC (Verwer, Hundsdorfer & Sommeijer 2004):
     w0 = 1 + eps / s^2, w1 = T_s(w0) / T_s'(w0), b_j = 1 / T_j(w0); stage j >= 2:
     Y_j = mu_j Y_{j-1} + nu_j Y_{j-2} + (1 - mu_j - nu_j) Y_0 + mut_j dt F(Y_{j-1}),
     mu_j = 2 w0 b_j / b_{j-1}, nu_j = -b_j / b_{j-2}, mut_j = 2 w1 b_j / b_{j-1}; stage 1:
     Y_1 = Y_0 + mut_1 dt F(Y_0), mut_1 = w1 / w0. Its stability polynomial
-    T_s(w0 + w1 z) / T_s(w0) stays within [-1, 1] on z in [-beta, 0], beta = (1 + w0) / w1."""
+    T_s(w0 + w1 z) / T_s(w0) stays within [-1, 1] on z in [-beta, 0], beta = (1 + w0) / w1.
+    Cached: the arrays returned are shared and must not be written."""
     w0 = 1.0 + damping / (s * s)
     T = [1.0, w0]
     U = [1.0, 2.0 * w0]  # Chebyshev polynomials of the second kind: T_j' = j U_{j-1}
@@ -255,6 +274,8 @@ def rkc_coefficients(s: int, damping: float = RKC_DAMPING):
         mu[j] = 2.0 * w0 * b[j] / b[j - 1]
         nu[j] = -b[j] / b[j - 2]
         mut[j] = 2.0 * w1 * b[j] / b[j - 1]
+    for c in (mu, nu, mut):
+        c.setflags(write=False)
     return (1.0 + w0) / w1, mu, nu, mut
 
 
