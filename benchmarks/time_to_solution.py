@@ -59,10 +59,18 @@ VARIANTS = {
     # examples/conveyor_fast.yaml as shipped: its settings, its 1 s averaging window and its
     # steady.min_time (2 s, where conveyor.yaml takes the 4 s default)
     "fast_average_1s": example_overrides("conveyor_fast"),
+    # the example before its sub-stepped laminar term (until 2026-12-03): the laminar term in
+    # the explicit step (auto_substepped keeps it there at dp = 1 mm), C_CFL 0.4 on the
+    # acoustic and force limits, 0.2 on the viscous one
+    "fast_explicit": example_overrides("conveyor_fast") + ["viscous_update=auto_substepped", "cfl=0.4"],
     # the same with a longer step: C_CFL 0.5 on the acoustic and force limits, 0.25 on the
     # viscous one; measured, not adopted: lind diverges with it, the two limits together
     # exceed the integrator's joint edge (docs/numerics.md, "The two limits add up")
-    "fast_cfl_0.5": example_overrides("conveyor_fast") + ["cfl=0.5", "cfl_viscous=0.25"],
+    "fast_cfl_0.5": example_overrides("conveyor_fast") + ["viscous_update=auto_substepped", "cfl=0.5",
+                                                          "cfl_viscous=0.25"],
+    # the example (its laminar term sub-stepped, no viscous limit on dt) at other acoustic C
+    **{f"fast_substepped_cfl_{c}": example_overrides("conveyor_fast") + ["viscous_update=substepped", f"cfl={c}"]
+       for c in ("0.5", "0.6", "0.7")},
 }
 
 

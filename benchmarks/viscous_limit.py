@@ -9,12 +9,13 @@ reports whether it stays bounded and the RMS error of u(z) against the exact
 semi-parabolic profile (in units of its surface velocity) at the end, beside the acoustic
 step 0.2 h / c0 the solver would otherwise take.
 
-With --implicit the film runs with `physics.viscous_update: implicit` (backward Euler in the
-laminar term, solver/implicit.py), where C may exceed the explicit edge; the CG iterations per
-step are reported.
+With --implicit (or --update implicit) the film runs with `physics.viscous_update: implicit`
+(backward Euler in the laminar term, solver/implicit.py), where C may exceed the explicit edge;
+the CG iterations per step are reported. --update substepped integrates the laminar term by
+RKC stages instead (the RKC stages per step are reported).
 
 Usage: python benchmarks/viscous_limit.py [--dp 0.00025] [--ch 1.8] [--c 0.2 0.25 0.3 0.35 0.42]
-           [--end 0.3] [--threads 2] [--implicit] [--physics KEY=VALUE ...]
+           [--end 0.3] [--threads 2] [--implicit | --update substepped] [--physics KEY=VALUE ...]
 """
 from __future__ import annotations
 
@@ -76,7 +77,8 @@ def run(dp: float, ch: float, C: float, end: float, update: str = "explicit", ph
             "acoustic_dt": acoustic, "acoustic_C": round(dt * sim.c0 / sim.h, 3), "steps": sim.steps,
             "t": sim.t, "status": "diverged" if reason else "bounded", "reason": reason,
             "u_rms_error": math.nan if reason else exact_error(sim), "wall_s": round(wall, 1),
-            "particles": sim.n, "cg_iterations_per_step": round(sim.solver_iterations / max(sim.steps, 1), 1)}
+            "particles": sim.n, "cg_iterations_per_step": round(sim.solver_iterations / max(sim.steps, 1), 1),
+            "rkc_stages_per_step": round(sim.rkc_stages / max(sim.steps, 1), 2)}
 
 
 def main(argv=None):
@@ -87,12 +89,14 @@ def main(argv=None):
     ap.add_argument("--end", type=float, default=0.3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--implicit", action="store_true", help="physics.viscous_update: implicit")
+    ap.add_argument("--update", choices=["explicit", "implicit", "substepped"], default="explicit",
+                    help="physics.viscous_update (--implicit: implicit)")
     ap.add_argument("--physics", nargs="*", default=[], metavar="KEY=VALUE",
                     help="scene physics settings, e.g. viscous_correction=true shifting.method=skillen")
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
     for C in a.c:
-        print(json.dumps(run(a.dp, a.ch, C, a.end, "implicit" if a.implicit else "explicit", a.physics)),
+        print(json.dumps(run(a.dp, a.ch, C, a.end, "implicit" if a.implicit else a.update, a.physics)),
               flush=True)
 
 

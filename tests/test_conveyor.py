@@ -134,7 +134,7 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
     assert fast_d["steady"]["min_time"] == 2.0 and fast_d["dp"] <= 1.0e-3
     fast = case_from_dict(fast_d)
     assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
-    assert (fast.cfl, fast.cfl_viscous, fast.viscous_update) == (0.4, 0.2, "auto_substepped")
+    assert (fast.cfl, fast.cfl_viscous, fast.viscous_update) == (0.6, 0.2, "substepped")
     assert fast.shift_min_speed == 0.5
     assert fast.shift_near_surface == "tangential"  # lind's, when the example runs with shifting=lind
     assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
