@@ -1,9 +1,10 @@
 """What the implicit laminar term (physics.viscous_update: implicit) costs and saves, measured.
 
 1. The paper case with config/paper.yaml's scheme (examples/conveyor.yaml, skillen) at cfl 0.4,
-   cfl_viscous 0.2 (the scheme's step until it took the sub-stepped update at cfl 0.6) at dp = 1 mm (--time s simulated) and 0.25 mm (--fine-time s) for each Ch of
-   --ch, with the explicit and the implicit update alternated within each of --rounds rounds
-   (the machine is noisy), started at h_n (start_depth: theory, no start-up film: only the
+   cfl_viscous 0.2 (the scheme's step until it took the sub-stepped update at cfl 0.6) at
+   dp = 1 mm (--time s simulated) and 0.25 mm (--fine-time s) for each Ch of --ch, with the
+   explicit and the implicit update alternated within each of --rounds rounds (the machine is
+   noisy), started at h_n (start_depth: theory, no start-up film: only the
    stepping is timed): steps, dt, ms a step, CG iterations a step, particle-steps/s, and the
    wall time per simulated second.
 2. The Herschel-Bulkley film (examples/hb_film.yaml) to --film-end s with each update: steps,

@@ -352,6 +352,7 @@ def film_error(sim) -> float:
     return float(np.sqrt(np.mean((u - ue) ** 2)) / exact.film(np.array([H]), H, g_along, sim.scene.nu)[0])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("update, outcome", [("substepped", "exact"), ("explicit", "diverged")])
 def test_at_the_fast_examples_step_the_substepped_film_is_exact_and_the_explicit_one_diverges(update, outcome):
     """examples/conveyor_fast.yaml's step, C = 0.6 on the acoustic limit h / c0, is at dp = 1 mm
