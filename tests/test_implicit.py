@@ -362,7 +362,7 @@ def test_at_the_fast_examples_step_the_substepped_film_is_exact_and_the_explicit
     measured 1.149 % of the surface velocity, as the explicit update at C_nu = 0.2 (1.149 %);
     bound 1.44 % (plus 25 %). The explicit update at the same step diverged at step 758
     (0.19 s). The film stayed bounded sub-stepped up to C = 0.75 and lost its profile at 0.8
-    (docs/numerics.md, "Sub-stepped viscosity")."""
+    (docs/numerics.md, "The two limits add up")."""
     sc = fast_scheme_film(update)
     sim = Simulation(sc)
     dt = 0.6 * sim.h / sim.c0
