@@ -44,6 +44,23 @@ def paper_case_simulation(dp: float, ch: float, update: str):
     return Simulation(scene, parts), case
 
 
+def step_recording(sim, steps: int, record):
+    """Step ``sim`` ``steps`` times, calling ``record(dt)`` before each viscous update (the
+    evaluation's accelerations in ``sim.out``); returns the simulation's own ``_solve_viscous``."""
+    original = sim._solve_viscous
+
+    def recorded(dt):
+        record(dt)
+        return original(dt)
+
+    sim._solve_viscous = recorded
+    for _ in range(steps):
+        reason = sim.step()
+        if reason:
+            raise SystemExit(f"the run stopped: {reason}")
+    return original
+
+
 def capture(dp: float, ch: float, steps: int, systems: int):
     """Step the case and keep the CG systems of its last ``systems`` steps: (the systems,
     the belt speed, the simulation, its own ``_solve_viscous``)."""
@@ -51,7 +68,6 @@ def capture(dp: float, ch: float, steps: int, systems: int):
 
     sim, case = paper_case_simulation(dp, ch, "implicit")
     kept: list[dict] = []
-    original = sim._solve_viscous
 
     def keep(dt):
         n = sim.n_active
@@ -59,13 +75,8 @@ def capture(dp: float, ch: float, steps: int, systems: int):
         kept.append({"op": op, "kind": sim.kind.copy(), "ax": sim.out[forces.AX].copy(),
                      "az": sim.out[forces.AZ].copy(), "dt": dt, "n": n, "pairs": int(sim.pairs.count.sum())})
         del kept[:-systems]
-        return original(dt)
 
-    sim._solve_viscous = keep
-    for _ in range(steps):
-        reason = sim.step()
-        if reason:
-            raise SystemExit(f"the run stopped: {reason}")
+    original = step_recording(sim, steps, keep)
     return kept, case.belt.speed, sim, original
 
 

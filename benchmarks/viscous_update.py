@@ -26,7 +26,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from cg_solve import paper_case_simulation  # noqa: E402
+from cg_solve import paper_case_simulation, step_recording  # noqa: E402
 from pair_loop import import_tree  # noqa: E402
 
 
@@ -34,17 +34,7 @@ def simulation(dp: float, ch: float, update: str, warmup: int):
     """The paper case stepped ``warmup`` times, and its last evaluation's accelerations and dt."""
     sim, _ = paper_case_simulation(dp, ch, update)
     kept = {}
-    original = sim._solve_viscous
-
-    def keep(dt):
-        kept.update(dt=dt, ax=sim.out[0].copy(), az=sim.out[1].copy())
-        return original(dt)
-
-    sim._solve_viscous = keep
-    for _ in range(warmup):
-        reason = sim.step()
-        if reason:
-            raise SystemExit(f"the run stopped: {reason}")
+    step_recording(sim, warmup, lambda dt: kept.update(dt=dt, ax=sim.out[0].copy(), az=sim.out[1].copy()))
     return sim, kept
 
 
