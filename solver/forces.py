@@ -488,42 +488,67 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     return pair_loop
 
 
+@nb.njit(cache=True)
+def thread_bounds(start, split, ncx, ncz, periodic):
+    """(lo, hi, wrap): thread t wrote particles [lo[t], hi[t]) (``thread_rows``) and, with a
+    periodic x, the last thread also [0, wrap[t]) (column 0, the next column of the last one)."""
+    nt = split.size - 1
+    lo = np.empty(nt, dtype=np.int64)
+    hi = np.empty(nt, dtype=np.int64)
+    wrap = np.zeros(nt, dtype=np.int64)
+    for t in range(nt):
+        lo[t], hi[t] = thread_rows(start, split, t, ncx, ncz)
+        if periodic and split[t + 1] == ncx:
+            wrap[t] = start[ncz]
+    return lo, hi, wrap
+
+
+@nb.njit(inline="always", cache=True)
+def row_sum(acc, lo, hi, wrap, i, q):
+    """sum_t acc[t, i, q] over the threads that wrote particle i, in thread order."""
+    s = 0.0
+    for t in range(acc.shape[0]):
+        if (lo[t] <= i < hi[t]) or i < wrap[t]:
+            s += acc[t, i, q]
+    return s
+
+
 @nb.njit(parallel=True, cache=True)
 def sum_thread_rows(acc, start, split, ncx, ncz, periodic, out, n):
     """out[q, i] = sum_t acc[t, i, q] over the threads that wrote particle i of [0, n) (thread
     t writes the particles of its columns and of the next column, ``thread_rows``; with a
-    periodic x the last thread's next column is column 0), 0 where none did."""
-    nt = acc.shape[0]
+    periodic x the last thread's next column is column 0), 0 where none did. One pass."""
+    lo, hi, wrap = thread_bounds(start, split, ncx, ncz, periodic)
     nq = acc.shape[2]
     for i in nb.prange(n):
         for q in range(nq):
-            out[q, i] = 0.0
-    for t in range(nt):
-        lo, hi = thread_rows(start, split, t, ncx, ncz)
-        for i in nb.prange(lo, hi):
-            for q in range(nq):
-                out[q, i] += acc[t, i, q]
-        if periodic and split[t + 1] == ncx and split[t] > 0:
-            for i in nb.prange(start[ncz]):
-                for q in range(nq):
-                    out[q, i] += acc[t, i, q]
+            out[q, i] = row_sum(acc, lo, hi, wrap, i, q)
+
+
+REDUCE_CHUNKS = 64  # particle chunks of the reductions over particles
 
 
 @nb.njit(parallel=True, cache=True)
 def reduce_accumulators(acc, kind, split, cl, gx, gz, out, n):
     """out = the threads' pair sums (``sum_thread_rows``), gravity added to fluid
-    accelerations.
+    accelerations, in one pass.
 
     Returns max |a| over fluid particles (for dt1).
     """
-    sum_thread_rows(acc, cl.start, split, cl.ncx, cl.ncz, cl.periodic, out, n)
-    amax = np.zeros(n)
-    for i in nb.prange(n):
-        if kind[i] == 0:
-            out[0, i] += gx
-            out[1, i] += gz
-            amax[i] = math.sqrt(out[0, i] ** 2 + out[1, i] ** 2)
-    return amax.max() if n > 0 else 0.0
+    lo, hi, wrap = thread_bounds(cl.start, split, cl.ncx, cl.ncz, cl.periodic)
+    nq = acc.shape[2]
+    part = np.zeros(REDUCE_CHUNKS)
+    for c in nb.prange(REDUCE_CHUNKS):
+        v = 0.0
+        for i in range(c * n // REDUCE_CHUNKS, (c + 1) * n // REDUCE_CHUNKS):
+            for q in range(nq):
+                out[q, i] = row_sum(acc, lo, hi, wrap, i, q)
+            if kind[i] == 0:
+                out[0, i] += gx
+                out[1, i] += gz
+                v = max(v, out[0, i] * out[0, i] + out[1, i] * out[1, i])
+        part[c] = v
+    return math.sqrt(part.max())
 
 
 VISCOUS_CORRECTION_MIN_DIVR = 1.9  # div r (m/rho volumes) of a particle with (nearly) full support

@@ -6,40 +6,43 @@ import math
 import numba as nb
 import numpy as np
 
+CHUNKS = 64  # particle chunks of the reductions
+
 
 @nb.njit(parallel=True, cache=True)
 def fluid_health(x, z, u, w, rho, mass, kind, n, rho0, walls, periodic, px0, period, out):
-    """One pass over fluid particles.
+    """One pass over fluid particles, in CHUNKS chunks (the sums do not depend on the threads).
 
     out[0]: number of non-finite fluid values, out[1]: max |rho/rho0 - 1|,
     out[2]: max depth of a fluid particle inside a wall rectangle (0 if none),
     out[3]: kinetic energy sum 0.5 m |v|^2.
     """
-    nbad = np.zeros(n)
-    dev = np.zeros(n)
-    pen = np.zeros(n)
-    ke = np.zeros(n)
-    for i in nb.prange(n):
-        if kind[i] != 0:
-            continue
-        if not (math.isfinite(x[i]) and math.isfinite(z[i]) and math.isfinite(u[i])
-                and math.isfinite(w[i]) and math.isfinite(rho[i])):
-            nbad[i] = 1.0
-            continue
-        dev[i] = abs(rho[i] / rho0 - 1.0)
-        ke[i] = 0.5 * mass[i] * (u[i] * u[i] + w[i] * w[i])
-        xi = x[i]
-        if periodic:
-            xi = px0 + (xi - px0) % period
-        for k in range(walls.shape[0]):
-            if walls[k, 0] < xi < walls[k, 1] and walls[k, 2] < z[i] < walls[k, 3]:
-                d = min(xi - walls[k, 0], walls[k, 1] - xi, z[i] - walls[k, 2], walls[k, 3] - z[i])
-                if d > pen[i]:
-                    pen[i] = d
-    out[0] = nbad.sum()
-    out[1] = dev.max() if n > 0 else 0.0
-    out[2] = pen.max() if n > 0 else 0.0
-    out[3] = ke.sum()
+    part = np.zeros((CHUNKS, 4))
+    size = (n + CHUNKS - 1) // CHUNKS
+    inv_rho0 = 1.0 / rho0
+    for c in nb.prange(CHUNKS):
+        nbad = dev = pen = ke = 0.0
+        for i in range(c * size, min(n, (c + 1) * size)):
+            if kind[i] != 0:
+                continue
+            if not (math.isfinite(x[i]) and math.isfinite(z[i]) and math.isfinite(u[i])
+                    and math.isfinite(w[i]) and math.isfinite(rho[i])):
+                nbad += 1.0
+                continue
+            dev = max(dev, abs(rho[i] * inv_rho0 - 1.0))
+            ke += 0.5 * mass[i] * (u[i] * u[i] + w[i] * w[i])
+            xi, zi = x[i], z[i]
+            if periodic and not (px0 <= xi < px0 + period):
+                xi = px0 + (xi - px0) % period
+            for k in range(walls.shape[0]):
+                if walls[k, 0] < xi < walls[k, 1] and walls[k, 2] < zi < walls[k, 3]:
+                    pen = max(pen, min(xi - walls[k, 0], walls[k, 1] - xi, zi - walls[k, 2],
+                                       walls[k, 3] - zi))
+        part[c, 0], part[c, 1], part[c, 2], part[c, 3] = nbad, dev, pen, ke
+    out[0] = part[:, 0].sum()
+    out[1] = part[:, 1].max()
+    out[2] = part[:, 2].max()
+    out[3] = part[:, 3].sum()
 
 
 def check(health, guards, dp: float) -> str:
