@@ -117,7 +117,7 @@ def column_window(cl, z, jx, iz, z_lo):
     return a, hi
 
 
-@nb.njit(cache=True)
+@nb.njit(parallel=True, cache=True)
 def assign_cells(x, z, kind, cl, cell):
     """Write each particle's cell (sentinel ncx*ncz for idle boundary particles).
 
@@ -126,20 +126,23 @@ def assign_cells(x, z, kind, cl, cell):
     n = x.size
     ncx, ncz = cl.ncx, cl.ncz
     ncells = ncx * ncz
-    has_fluid = np.zeros(ncells, dtype=np.bool_)
-    bad = -1
-    for i in range(n):
+    for i in nb.prange(n):
         ix, iz = cell_of(cl, x[i], z[i])
         if ix < 0 or ix >= ncx or iz < 0 or iz >= ncz or not (math.isfinite(x[i]) and math.isfinite(z[i])):
             cell[i] = ncells
-            if kind[i] == 0 and bad < 0:
-                bad = i
-            continue
-        c = ix * ncz + iz
-        cell[i] = c
-        if kind[i] == 0:
-            has_fluid[c] = True
+        else:
+            cell[i] = ix * ncz + iz
+    has_fluid = np.zeros(ncells + 1, dtype=np.bool_)
     for i in range(n):
+        if kind[i] == 0:
+            has_fluid[cell[i]] = True
+    bad = -1
+    if has_fluid[ncells]:
+        for i in range(n):
+            if kind[i] == 0 and cell[i] == ncells:
+                bad = i
+                break
+    for i in nb.prange(n):
         if kind[i] == 0 or cell[i] == ncells:
             continue
         c = cell[i]

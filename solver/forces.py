@@ -504,13 +504,23 @@ def thread_bounds(start, split, ncx, ncz, periodic):
 
 
 @nb.njit(inline="always", cache=True)
-def row_sum(acc, lo, hi, wrap, i, q):
-    """sum_t acc[t, i, q] over the threads that wrote particle i, in thread order."""
-    s = 0.0
+def sum_row(acc, lo, hi, wrap, i, out):
+    """out[:, i] = sum_t acc[t, i, :] over the threads that wrote particle i, in thread order
+    (0 where none did)."""
+    nq = acc.shape[2]
+    first = True
     for t in range(acc.shape[0]):
         if (lo[t] <= i < hi[t]) or i < wrap[t]:
-            s += acc[t, i, q]
-    return s
+            if first:
+                for q in range(nq):
+                    out[q, i] = 0.0 + acc[t, i, q]
+                first = False
+            else:
+                for q in range(nq):
+                    out[q, i] += acc[t, i, q]
+    if first:
+        for q in range(nq):
+            out[q, i] = 0.0
 
 
 @nb.njit(parallel=True, cache=True)
@@ -519,10 +529,8 @@ def sum_thread_rows(acc, start, split, ncx, ncz, periodic, out, n):
     t writes the particles of its columns and of the next column, ``thread_rows``; with a
     periodic x the last thread's next column is column 0), 0 where none did. One pass."""
     lo, hi, wrap = thread_bounds(start, split, ncx, ncz, periodic)
-    nq = acc.shape[2]
     for i in nb.prange(n):
-        for q in range(nq):
-            out[q, i] = row_sum(acc, lo, hi, wrap, i, q)
+        sum_row(acc, lo, hi, wrap, i, out)
 
 
 REDUCE_CHUNKS = 64  # particle chunks of the reductions over particles
@@ -536,13 +544,11 @@ def reduce_accumulators(acc, kind, split, cl, gx, gz, out, n):
     Returns max |a| over fluid particles (for dt1).
     """
     lo, hi, wrap = thread_bounds(cl.start, split, cl.ncx, cl.ncz, cl.periodic)
-    nq = acc.shape[2]
     part = np.zeros(REDUCE_CHUNKS)
     for c in nb.prange(REDUCE_CHUNKS):
         v = 0.0
         for i in range(c * n // REDUCE_CHUNKS, (c + 1) * n // REDUCE_CHUNKS):
-            for q in range(nq):
-                out[q, i] = row_sum(acc, lo, hi, wrap, i, q)
+            sum_row(acc, lo, hi, wrap, i, out)
             if kind[i] == 0:
                 out[0, i] += gx
                 out[1, i] += gz
