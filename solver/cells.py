@@ -166,19 +166,32 @@ def assign_cells(x, z, kind, cl, cell):
     return bad
 
 
-@nb.njit(cache=True)
+SORT_CHUNKS = 4  # particle chunks of the counting sort (placed in parallel, in chunk order)
+
+
+@nb.njit(parallel=True, cache=True)
 def counting_sort(cell, nbuckets, order, start):
-    """order: particle indices sorted by cell; start[c]..start[c+1] is cell c's range."""
-    start[:] = 0
-    for i in range(cell.size):
-        start[cell[i] + 1] += 1
+    """order: particle indices sorted by cell, stable; start[c]..start[c+1] is cell c's range.
+    Each chunk of particles counts its cells, then places its particles after those of the
+    chunks before it in the same cell."""
+    n = cell.size
+    slots = np.zeros((SORT_CHUNKS, nbuckets), dtype=np.int64)
+    for k in nb.prange(SORT_CHUNKS):
+        for i in range(k * n // SORT_CHUNKS, (k + 1) * n // SORT_CHUNKS):
+            slots[k, cell[i]] += 1
+    total = 0
     for c in range(nbuckets):
-        start[c + 1] += start[c]
-    fill = start[:-1].copy()
-    for i in range(cell.size):
-        c = cell[i]
-        order[fill[c]] = i
-        fill[c] += 1
+        start[c] = total
+        for k in range(SORT_CHUNKS):
+            count = slots[k, c]
+            slots[k, c] = total
+            total += count
+    start[nbuckets] = total
+    for k in nb.prange(SORT_CHUNKS):
+        for i in range(k * n // SORT_CHUNKS, (k + 1) * n // SORT_CHUNKS):
+            c = cell[i]
+            order[slots[k, c]] = i
+            slots[k, c] += 1
 
 
 @nb.njit(parallel=True, cache=True)
