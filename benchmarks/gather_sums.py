@@ -321,8 +321,9 @@ def measure(sim: Simulation, calls: int) -> dict:
     loop = make_gather_loop(s.diffusion, o["shifting"], o["shift_correction"], o["column_reference"],
                             o["viscous_correction"], o["volume"])
     g = s.scene.gravity
+    forces.pressure_and_inverse_density(s.rho, s.p, s.irho, s.B, s.rho0)
     fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
-                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume)
+                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho)
     acc = np.zeros((s.nthreads, s.n, s.nq))
     out = np.zeros((s.nq, s.n))
     vmax = np.zeros(s.nthreads)

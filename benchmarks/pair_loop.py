@@ -51,9 +51,11 @@ def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, parti
     for _ in range(warmup):
         s.step()
     options = s.pair_options
+    forces.pressure_and_inverse_density(s.rho, s.p, s.irho, s.B, s.rho0)
     fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
-                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume)
-    loops = [(old_forces.make_pair_loop(**options), old_forces.PairFields(*fields)),
+                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho)
+    old_fields = old_forces.PairFields(*fields[:len(old_forces.PairFields._fields)])
+    loops = [(old_forces.make_pair_loop(**options), old_fields),
              (forces.make_pair_loop(**options), fields)]
 
     def call(k):

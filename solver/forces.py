@@ -143,6 +143,7 @@ class PairFields(NamedTuple):
     nu_p: np.ndarray  # each particle's kinematic viscosity (read with variable_viscosity only)
     gamma: np.ndarray  # each particle's last strain rate (read with strain_correction only)
     cell: np.ndarray  # lattice cell dp dz of each particle (read with shifting only)
+    irho: np.ndarray  # 1 / rho of each particle (``pressure_and_inverse_density``)
 
 
 class PairConstants(NamedTuple):
@@ -271,7 +272,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
         with implicit viscosity, thread t's fluid pairs in row t of the ``PairList`` arrays
         (passed one by one: numba 0.68 loses writes to arrays held in a tuple inside prange)."""
-        x, z, u, w, rho, p, mass, kind = f.x, f.z, f.u, f.w, f.rho, f.p, f.mass, f.kind
+        x, z, u, w, rho, p, mass, kind, irho = f.x, f.z, f.u, f.w, f.rho, f.p, f.mass, f.kind, f.irho
         start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
         h, nu, hc0, rho0 = k.h, k.nu, k.hc0, k.rho0
         nt = split.size - 1
@@ -315,9 +316,9 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                     for a in range(a0, a1):
                         xa, za, ua, wa = x[a], z[a], u[a], w[a]
                         ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
-                        Va = ma / ra
+                        ira = irho[a]
+                        Va = ma * ira
                         cell_a = f.cell[a]
-                        ira = 1.0 / ra
                         s_ax = s_az = s_drho = 0.0
                         s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
                         s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
@@ -356,10 +357,14 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 vdotr = du * dx + dw * dz
                                 rdotg = F * r2
                                 mb = mass[b]
-                                irb = 1.0 / rb
+                                irb = irho[b]
                                 Vb = mb * irb
-                                inv_r2e = 1.0 / (r2 + eta2)
-                                inv_rsum = 1.0 / (ra + rb)
+                                # one division for 1 / (r^2 + eta^2) and 1 / (rho_a + rho_b)
+                                r2e = r2 + eta2
+                                rsum = ra + rb
+                                d = 1.0 / (r2e * rsum)
+                                inv_r2e = d * rsum
+                                inv_rsum = d * r2e
                                 ca, cb = continuity_terms(ra, rb, F, vdotr)
                                 s_drho += ca * Vb
                                 drho_b = cb * Va
@@ -580,10 +585,24 @@ def correct_viscous_term(out, kind, nu, n):
         out[AZ, i] -= 2.0 * nu * (gx * out[DWX, i] + gz * out[DWZ, i])
 
 
+@nb.njit(inline="always", cache=True)
+def tait(rho, B, rho0):
+    """P = B ((rho/rho0)^7 - 1)."""
+    r = rho / rho0
+    r2 = r * r
+    return B * (r2 * r2 * r2 * r - 1.0)
+
+
 @nb.njit(parallel=True, cache=True)
 def equation_of_state(rho, p, B, rho0):
     """Tait: P = B ((rho/rho0)^7 - 1)."""
     for i in nb.prange(rho.size):
-        r = rho[i] / rho0
-        r2 = r * r
-        p[i] = B * (r2 * r2 * r2 * r - 1.0)
+        p[i] = tait(rho[i], B, rho0)
+
+
+@nb.njit(parallel=True, cache=True)
+def pressure_and_inverse_density(rho, p, irho, B, rho0):
+    """Tait's P (``equation_of_state``) and 1 / rho, which the pair loop reads."""
+    for i in nb.prange(rho.size):
+        p[i] = tait(rho[i], B, rho0)
+        irho[i] = 1.0 / rho[i]

@@ -140,6 +140,7 @@ class Simulation:
             k_hyd=self.rho0 * s.gravity[1] / self.B, k_col=self.rho0 * s.gravity[1] / self.c0 ** 2,
             delta=self.delta, av=(s.physics.artificial_viscosity or 0.0) * self.h * self.c0)
         self.p = np.zeros(self.n)
+        self.irho = np.zeros(self.n)  # 1 / rho, for the pair loop
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
         self.surface_flag = np.zeros(self.n, dtype=np.int8)
@@ -199,10 +200,10 @@ class Simulation:
                              self.h, self.rho0, s.dp * s.dp, self.n_lattice)
         else:
             boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
-        forces.equation_of_state(self.rho, self.p, self.B, self.rho0)
+        forces.pressure_and_inverse_density(self.rho, self.p, self.irho, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
-                                   self.gamma_p, self.cell_volume)
+                                   self.gamma_p, self.cell_volume, self.irho)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
             # more pairs than the list holds: widen it and evaluate again
