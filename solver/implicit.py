@@ -31,7 +31,8 @@ each pair once) and sums the diagonal sum_b c_ab. Every product with C (CG's and
 sub-stepped update's) runs over those per-thread lists: thread t adds c_ab y_b to row a and
 c_ba y_a to row b of its own accumulator, on the rows it writes (``forces.thread_rows``), and
 the threads' shares are summed as the pair loop's are (``offdiagonal_products``,
-``forces.sum_thread_rows``). The list is never arranged by rows.
+``forces.sum_thread_rows``; a sub-stepped stage sums them in its own pass over the rows). The
+list is never arranged by rows.
 """
 from __future__ import annotations
 
@@ -41,12 +42,12 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import sum_thread_rows, thread_rows
+from .forces import sum_thread_rows, thread_bounds, thread_rows
 
 TOLERANCE = 1.0e-6  # CG stops when |residual| <= TOLERANCE |right-hand side| (2-norm, each component)
 MAX_ITERATIONS = 1000
 WORK_ROWS = 13  # CG's scratch rows
-SUBSTEP_WORK_ROWS = 8  # the sub-stepped update's
+SUBSTEP_WORK_ROWS = 6  # the sub-stepped update's: Y_{j-2}, Y_{j-1}, Y_j
 
 
 def pairs_per_particle(ch: float) -> float:
@@ -62,8 +63,8 @@ def pair_capacity(n: int, ch: float, threads: int) -> int:
 
 def bytes_per_particle(ch: float, substeps: bool = False) -> float:
     """Memory this update adds (2 threads): the pair list (16 B a pair), the two threads'
-    product shares (4 numbers) and the scratch rows (13 for CG, 8 sub-stepped): 0.62 and
-    0.58 kB a particle at Ch = 1.8."""
+    product shares (4 numbers) and the scratch rows (13 for CG, 6 sub-stepped): 0.62 and
+    0.57 kB a particle at Ch = 1.8."""
     return pairs_per_particle(ch) * 16.0 + 8.0 * (4 + (SUBSTEP_WORK_ROWS if substeps else WORK_ROWS))
 
 
@@ -299,13 +300,21 @@ def eigenvalue_bound(diag, kind, n: int) -> float:
 
 
 @nb.njit(parallel=True, cache=True)
-def _rkc_stage(diag, kind, ax, az, y1x, y1z, y2x, y2z, sx, sz, outx, outz, mu, nu, mut_dt, n):
+def _rkc_stage(op, kind, ax, az, y1x, y1z, y2x, y2z, outx, outz, mu, nu, mut_dt, n):
     """out = mu y1 + nu y2 + mut dt (a - C y1) on the fluid rows, 0 elsewhere (Y_0 = 0), with
-    (C y1)_a = diag_a y1_a - s_a, s the off-diagonal products of y1."""
+    (C y1)_a = diag_a y1_a - s_a, s_a the threads' shares of row a (``_offdiagonal_shares`` of
+    y1, summed here in thread order as ``forces.sum_thread_rows`` would)."""
+    diag, shares, start, split, ncx, ncz, periodic = op[5], op[6], op[7], op[8], op[9], op[10], op[11]
+    lo, hi, wrap = thread_bounds(start, split, ncx, ncz, periodic)
     for a in nb.prange(n):
         if kind[a] == 0:
-            outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - diag[a] * y1x[a] + sx[a])
-            outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - diag[a] * y1z[a] + sz[a])
+            sx = sz = 0.0
+            for t in range(shares.shape[0]):
+                if (lo[t] <= a < hi[t]) or a < wrap[t]:
+                    sx += shares[t, a, 0]
+                    sz += shares[t, a, 1]
+            outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - diag[a] * y1x[a] + sx)
+            outz[a] = mu * y1z[a] + nu * y2z[a] + mut_dt * (az[a] - diag[a] * y1z[a] + sz)
         else:
             outx[a] = outz[a] = 0.0
 
@@ -340,13 +349,13 @@ def substep(op, kind, dt: float, ax, az, n: int, work) -> int:
     s = rkc_stages(dt * eigenvalue_bound(diag, kind, n))
     _, mu, nu, mut = rkc_coefficients(s)
     ys = [(work[0], work[1]), (work[2], work[3]), (work[4], work[5])]  # Y_{j-2}, Y_{j-1}, Y_j
-    s_off = work[6:8]  # the off-diagonal products
+    pair_i, pair_j, pair_k, pair_count, mass, _, shares, start, split, ncx, ncz, periodic = op
     _first_stage(kind, ax, az, *ys[0], *ys[1], mut[1] * dt, n)
     for j in range(2, s + 1):
         (y2x, y2z), (y1x, y1z), (ox, oz) = ys
-        offdiagonal_products(op, y1x, y1z, s_off, n)
-        _rkc_stage(diag, kind, ax, az, y1x, y1z, y2x, y2z, s_off[0], s_off[1], ox, oz, mu[j], nu[j],
-                   mut[j] * dt, n)
+        _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, y1x, y1z, shares, start, split, ncx,
+                            ncz, periodic)
+        _rkc_stage(op, kind, ax, az, y1x, y1z, y2x, y2z, ox, oz, mu[j], nu[j], mut[j] * dt, n)
         ys = [ys[1], ys[2], ys[0]]
     _take_increment(kind, *ys[1], ax, az, 1.0 / dt, n)
     return s
