@@ -359,12 +359,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 mb = mass[b]
                                 irb = irho[b]
                                 Vb = mb * irb
-                                # one division for 1 / (r^2 + eta^2) and 1 / (rho_a + rho_b)
-                                r2e = r2 + eta2
-                                rsum = ra + rb
-                                d = 1.0 / (r2e * rsum)
-                                inv_r2e = d * rsum
-                                inv_rsum = d * r2e
+                                inv_r2e = 1.0 / (r2 + eta2)
+                                inv_rsum = 1.0 / (ra + rb)
                                 ca, cb = continuity_terms(ra, rb, F, vdotr)
                                 s_drho += ca * Vb
                                 drho_b = cb * Va
