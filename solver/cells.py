@@ -166,7 +166,7 @@ def assign_cells(x, z, kind, cl, cell):
     return bad
 
 
-SORT_CHUNKS = 4  # particle chunks of the counting sort (placed in parallel, in chunk order)
+SORT_CHUNKS = 2  # particle chunks of the counting sort (placed in parallel, in chunk order)
 
 
 @nb.njit(parallel=True, cache=True)

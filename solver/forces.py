@@ -507,21 +507,24 @@ def thread_bounds(start, split, ncx, ncz, periodic):
 @nb.njit(inline="always", cache=True)
 def sum_row(acc, lo, hi, wrap, i, out):
     """out[:, i] = sum_t acc[t, i, :] over the threads that wrote particle i, in thread order
-    (0 where none did)."""
+    (0 where none did; a copy where one did, as most rows are)."""
     nq = acc.shape[2]
-    first = True
+    owners = 0
+    last = 0
     for t in range(acc.shape[0]):
         if (lo[t] <= i < hi[t]) or i < wrap[t]:
-            if first:
-                for q in range(nq):
-                    out[q, i] = 0.0 + acc[t, i, q]
-                first = False
-            else:
-                for q in range(nq):
-                    out[q, i] += acc[t, i, q]
-    if first:
+            owners += 1
+            last = t
+    if owners == 1:
         for q in range(nq):
-            out[q, i] = 0.0
+            out[q, i] = acc[last, i, q]
+        return
+    for q in range(nq):
+        out[q, i] = 0.0
+    for t in range(acc.shape[0]):
+        if (lo[t] <= i < hi[t]) or i < wrap[t]:
+            for q in range(nq):
+                out[q, i] += acc[t, i, q]
 
 
 @nb.njit(parallel=True, cache=True)
