@@ -6,7 +6,7 @@ import math
 import numba as nb
 import numpy as np
 
-CHUNKS = 64  # particle chunks of the reductions
+from .forces import REDUCE_CHUNKS as CHUNKS
 
 
 @nb.njit(parallel=True, cache=True)

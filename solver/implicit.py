@@ -42,7 +42,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import sum_thread_rows, thread_bounds, thread_rows
+from .forces import REDUCE_CHUNKS, sum_thread_rows, thread_bounds, thread_rows
 
 TOLERANCE = 1.0e-6  # CG stops when |residual| <= TOLERANCE |right-hand side| (2-norm, each component)
 MAX_ITERATIONS = 1000
@@ -282,7 +282,7 @@ def rkc_coefficients(s: int, damping: float = RKC_DAMPING):
 
 @nb.njit(parallel=True, cache=True)
 def _largest_diagonal(diag, kind, n):
-    chunks = 64
+    chunks = REDUCE_CHUNKS
     m = np.zeros(chunks)
     for c in nb.prange(chunks):
         v = 0.0
@@ -364,7 +364,7 @@ def substep(op, kind, dt: float, ax, az, n: int, work) -> int:
 @nb.njit(parallel=True, cache=True)
 def largest_fluid_acceleration(ax, az, kind, n):
     """max |a| over the fluid particles of [0, n) (0 for none)."""
-    chunks = 64
+    chunks = REDUCE_CHUNKS
     m = np.zeros(chunks)
     for c in nb.prange(chunks):
         v = 0.0
