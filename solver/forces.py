@@ -505,6 +505,12 @@ def thread_bounds(start, split, ncx, ncz, periodic):
 
 
 @nb.njit(inline="always", cache=True)
+def wrote(lo, hi, wrap, t, i):
+    """Whether thread t wrote particle i (``thread_bounds``)."""
+    return (lo[t] <= i < hi[t]) or i < wrap[t]
+
+
+@nb.njit(inline="always", cache=True)
 def sum_row(acc, lo, hi, wrap, i, out):
     """out[:, i] = sum_t acc[t, i, :] over the threads that wrote particle i, in thread order
     (0 where none did; a copy where one did, as most rows are)."""
@@ -512,7 +518,7 @@ def sum_row(acc, lo, hi, wrap, i, out):
     owners = 0
     last = 0
     for t in range(acc.shape[0]):
-        if (lo[t] <= i < hi[t]) or i < wrap[t]:
+        if wrote(lo, hi, wrap, t, i):
             owners += 1
             last = t
     if owners == 1:
@@ -522,7 +528,7 @@ def sum_row(acc, lo, hi, wrap, i, out):
     for q in range(nq):
         out[q, i] = 0.0
     for t in range(acc.shape[0]):
-        if (lo[t] <= i < hi[t]) or i < wrap[t]:
+        if wrote(lo, hi, wrap, t, i):
             for q in range(nq):
                 out[q, i] += acc[t, i, q]
 

@@ -18,11 +18,10 @@ def fluid_health(x, z, u, w, rho, mass, kind, n, rho0, walls, periodic, px0, per
     out[3]: kinetic energy sum 0.5 m |v|^2.
     """
     part = np.zeros((CHUNKS, 4))
-    size = (n + CHUNKS - 1) // CHUNKS
     inv_rho0 = 1.0 / rho0
     for c in nb.prange(CHUNKS):
         nbad = dev = pen = ke = 0.0
-        for i in range(c * size, min(n, (c + 1) * size)):
+        for i in range(c * n // CHUNKS, (c + 1) * n // CHUNKS):
             if kind[i] != 0:
                 continue
             if not (math.isfinite(x[i]) and math.isfinite(z[i]) and math.isfinite(u[i])

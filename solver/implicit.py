@@ -42,7 +42,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import REDUCE_CHUNKS, sum_thread_rows, thread_bounds, thread_rows
+from .forces import REDUCE_CHUNKS, sum_thread_rows, thread_bounds, thread_rows, wrote
 
 TOLERANCE = 1.0e-6  # CG stops when |residual| <= TOLERANCE |right-hand side| (2-norm, each component)
 MAX_ITERATIONS = 1000
@@ -121,12 +121,20 @@ def _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, s
 
 
 @nb.njit(cache=True)
-def offdiagonal_products(op, yx, yz, s, n):
-    """s[:, a] = sum_b c_ab (yx, yz)_b over the listed fluid pairs, for every row of [0, n)
-    (0 on rows with none: walls); ``op`` from ``operator``, ``s`` of shape (2, >= n)."""
+def offdiagonal_shares(op, yx, yz):
+    """The threads' shares of the products sum_b c_ab (yx, yz)_b (``_offdiagonal_shares``), in
+    ``op``'s scratch; ``op`` from ``operator``."""
     pair_i, pair_j, pair_k, pair_count, mass, _, acc, start, split, ncx, ncz, periodic = op
     _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, yx, yz, acc, start, split, ncx, ncz,
                         periodic)
+
+
+@nb.njit(cache=True)
+def offdiagonal_products(op, yx, yz, s, n):
+    """s[:, a] = sum_b c_ab (yx, yz)_b over the listed fluid pairs, for every row of [0, n)
+    (0 on rows with none: walls); ``op`` from ``operator``, ``s`` of shape (2, >= n)."""
+    offdiagonal_shares(op, yx, yz)
+    _, _, _, _, _, _, acc, start, split, ncx, ncz, periodic = op
     sum_thread_rows(acc, start, split, ncx, ncz, periodic, s, n)
 
 
@@ -304,13 +312,13 @@ def _rkc_stage(op, kind, ax, az, y1x, y1z, y2x, y2z, outx, outz, mu, nu, mut_dt,
     """out = mu y1 + nu y2 + mut dt (a - C y1) on the fluid rows, 0 elsewhere (Y_0 = 0), with
     (C y1)_a = diag_a y1_a - s_a, s_a the threads' shares of row a (``_offdiagonal_shares`` of
     y1, summed here in thread order as ``forces.sum_thread_rows`` would)."""
-    diag, shares, start, split, ncx, ncz, periodic = op[5], op[6], op[7], op[8], op[9], op[10], op[11]
+    _, _, _, _, _, diag, shares, start, split, ncx, ncz, periodic = op
     lo, hi, wrap = thread_bounds(start, split, ncx, ncz, periodic)
     for a in nb.prange(n):
         if kind[a] == 0:
             sx = sz = 0.0
             for t in range(shares.shape[0]):
-                if (lo[t] <= a < hi[t]) or a < wrap[t]:
+                if wrote(lo, hi, wrap, t, a):
                     sx += shares[t, a, 0]
                     sz += shares[t, a, 1]
             outx[a] = mu * y1x[a] + nu * y2x[a] + mut_dt * (ax[a] - diag[a] * y1x[a] + sx)
@@ -349,12 +357,10 @@ def substep(op, kind, dt: float, ax, az, n: int, work) -> int:
     s = rkc_stages(dt * eigenvalue_bound(diag, kind, n))
     _, mu, nu, mut = rkc_coefficients(s)
     ys = [(work[0], work[1]), (work[2], work[3]), (work[4], work[5])]  # Y_{j-2}, Y_{j-1}, Y_j
-    pair_i, pair_j, pair_k, pair_count, mass, _, shares, start, split, ncx, ncz, periodic = op
     _first_stage(kind, ax, az, *ys[0], *ys[1], mut[1] * dt, n)
     for j in range(2, s + 1):
         (y2x, y2z), (y1x, y1z), (ox, oz) = ys
-        _offdiagonal_shares(pair_i, pair_j, pair_k, pair_count, mass, y1x, y1z, shares, start, split, ncx,
-                            ncz, periodic)
+        offdiagonal_shares(op, y1x, y1z)
         _rkc_stage(op, kind, ax, az, y1x, y1z, y2x, y2z, ox, oz, mu[j], nu[j], mut[j] * dt, n)
         ys = [ys[1], ys[2], ys[0]]
     _take_increment(kind, *ys[1], ax, az, 1.0 / dt, n)
