@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .roots import bisect
+
 
 @dataclass(frozen=True)
 class HBFluid:
@@ -48,19 +50,6 @@ class HBFluid:
         return u_p * (h - h0 / (p + 1))
 
 
-def _bisect(f, lo: float, hi: float, rel: float = 1e-13) -> float:
-    """Root of an increasing f on [lo, hi] (f(lo) < 0 < f(hi))."""
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if f(mid) < 0:
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo <= rel * hi:
-            break
-    return 0.5 * (lo + hi)
-
-
 def normal_depth(fluid: HBFluid, u_b: float, g: float, theta: float) -> float:
     """h_n: q(h_n, sin theta) = u_b h_n (q / h grows with h, from 0 at the yield depth)."""
     S = math.sin(theta)
@@ -68,7 +57,7 @@ def normal_depth(fluid: HBFluid, u_b: float, g: float, theta: float) -> float:
     hi = max(2.0 * h_y, 1e-6)
     while fluid.flux(hi, S, g) < u_b * hi:
         hi *= 2.0
-    return _bisect(lambda h: fluid.flux(h, S, g) - u_b * h, h_y, hi)
+    return bisect(lambda h: fluid.flux(h, S, g) - u_b * h, h_y, hi)
 
 
 def driving_slope(fluid: HBFluid, h: float, u_b: float, g: float) -> float:
@@ -77,7 +66,7 @@ def driving_slope(fluid: HBFluid, h: float, u_b: float, g: float) -> float:
     hi = max(2.0 * lo, 1e-6)
     while fluid.flux(h, hi, g) < u_b * h:
         hi *= 2.0
-    return _bisect(lambda S: fluid.flux(h, S, g) - u_b * h, lo, hi)
+    return bisect(lambda S: fluid.flux(h, S, g) - u_b * h, lo, hi)
 
 
 def front_profile(fluid: HBFluid, u_b: float, g: float, theta: float, eta_max: float = 0.999,

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solver.roots import bisect
+
 
 @dataclass
 class GCIResult:
@@ -34,18 +36,10 @@ def observed_order(ratio: float, r21: float, r32: float) -> float:
     (bisection on a strictly decreasing function)."""
     def f(p):
         return (1.0 - r21 ** -p) / (r32 ** p - 1.0) - ratio
-    lo, hi = 1e-9, 1.0
+    hi = 1.0
     while f(hi) > 0:
-        lo, hi = hi, 2.0 * hi
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if f(mid) > 0:
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo <= 1e-14 * hi:
-            break
-    return 0.5 * (lo + hi)
+        hi *= 2.0
+    return bisect(lambda p: -f(p), 0.5 * hi if hi > 1.0 else 1e-9, hi, rel=1e-14)
 
 
 def gci(h, phi, safety: float = 1.25) -> GCIResult:

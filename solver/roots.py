@@ -1,0 +1,16 @@
+"""Root of a monotone scalar function by bisection."""
+from __future__ import annotations
+
+
+def bisect(f, lo: float, hi: float, rel: float = 1e-13) -> float:
+    """x in [lo, hi] with f(x) = 0 for an increasing f with f(lo) < 0 <= f(hi): halves the
+    bracket until hi - lo <= rel hi (at most 200 halvings)."""
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if f(mid) < 0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= rel * hi:
+            break
+    return 0.5 * (lo + hi)
