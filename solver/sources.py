@@ -16,13 +16,19 @@ import sys
 from pathlib import Path
 
 
+def files_hash(files, names: bool = True) -> str:
+    """sha256 (16 hex digits) of the files' contents in the given order, each preceded by
+    its file name when ``names``."""
+    h = hashlib.sha256()
+    for f in map(Path, files):
+        h.update((f.name.encode() if names else b"") + f.read_bytes())
+    return h.hexdigest()[:16]
+
+
 @functools.cache
 def source_hash() -> str:
-    """sha256 (16 hex digits) of every solver/*.py file, names and contents."""
-    h = hashlib.sha256()
-    for f in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(f.name.encode() + f.read_bytes())
-    return h.hexdigest()[:16]
+    """``files_hash`` of every solver/*.py file, names and contents."""
+    return files_hash(sorted(Path(__file__).parent.glob("*.py")))
 
 
 def cache_base() -> Path:

@@ -27,20 +27,14 @@ def _write_if_changed(path, text):
 CONFIG_FILE = "results/campaign_config.yaml"
 _write_if_changed(CONFIG_FILE, yaml.safe_dump(config, sort_keys=False))
 
-from solver.sources import source_hash
+from solver.sources import files_hash, source_hash
 
 SOLVER_HASH = source_hash()  # a param of every run: a changed solver reruns them
 
-
-def _code_hash(*modules):
-    import hashlib
-    from pathlib import Path
-    return hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in modules)).hexdigest()[:16]
-
-
 import study.metrics, study.reference
 
-METRICS_HASH = _code_hash(study.metrics, study.reference)  # a param of the metrics: new metric code rescores
+# a param of the metrics: new metric code rescores
+METRICS_HASH = files_hash([study.metrics.__file__, study.reference.__file__], names=False)
 
 wildcard_constraints:
     case=CASE_ID,
