@@ -30,7 +30,9 @@ def zeta_f_error(t, toe, u_b: float) -> float:
     """Standard error of zeta_f from the toe's own scatter: se of the least-squares toe slope
     over the last second of the record (the second zeta_f is measured over), widened for the
     residuals' lag-1 correlation (solver.steady.front_velocity_fit), over u_b. NaN with fewer
-    than 4 samples in that second (no scatter to measure)."""
+    than 4 samples in that second (no scatter to measure). A wander of the toe slower than
+    the second shows as slope, not scatter: at dp <= 1 mm the one-second velocities of a
+    settled front scatter by up to 1.6 times this se (docs/conveyor.md, "The toe's wander")."""
     from solver.steady import FRONT_VELOCITY_SPAN, front_velocity_fit
     t = np.asarray(t, dtype=float)
     if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
