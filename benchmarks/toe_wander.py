@@ -65,7 +65,8 @@ def wander(t, y, ub: float, start: float) -> dict:
 
 def row(name: str, w: dict, dp: float) -> str:
     return (f"| {name} | {w['rms'] / dp:.2f} | {w['acf_zero']:.2f} | {w['seconds']} | {w['v_rms']:.2f} | "
-            f"{w['v_max']:.2f} | {w['se2_median']:.2f} | {w['within_2se']} | {w['below_1']:.2f} | {w['below_1_2se']:.2f} |")
+            f"{w['v_max']:.2f} | {w['se2_median']:.2f} | {w['within_2se']} | {w['below_1']:.2f} | "
+            f"{w['below_1_2se']:.2f} |")
 
 
 HEADER = ("| signal | rms about trend [dp] | acf zero [s] | seconds | 1 s velocity rms [% u_b] | largest | "

@@ -26,9 +26,9 @@ import time
 from pathlib import Path
 
 import numba
-import numpy as np
 import yaml
 
+from solver import exact
 from solver.scene import scene_from_dict
 from solver.simulation import Simulation
 from throughput import set_physics
@@ -52,13 +52,9 @@ def film(dp: float, ch: float, end: float, update: str = "explicit", physics=())
 def exact_error(sim: Simulation) -> float:
     """RMS of u - u_exact over fluid particles, over the exact surface velocity."""
     s = sim.scene
-    n = sim.n_active
-    f = sim.kind[:n] == 0
-    z, u = sim.z[:n][f], sim.u[:n][f]
+    f = sim.kind[:sim.n_active] == 0
     H = max(b.z[1] for b in s.fluid.blocks)
-    g = s.gravity[0]
-    exact = g / s.nu * (H * z - 0.5 * z * z)
-    return float(np.sqrt(np.mean((u - exact) ** 2)) / (g / s.nu * 0.5 * H * H))
+    return exact.film_rms_error(sim.z[:sim.n_active][f], sim.u[:sim.n_active][f], H, s.gravity[0], s.nu)
 
 
 def run(dp: float, ch: float, C: float, end: float, update: str = "explicit", physics=()) -> dict:

@@ -36,6 +36,13 @@ def film(z, depth: float, g_along: float, nu: float):
     return g_along / nu * (depth * z - z ** 2 / 2)
 
 
+def film_rms_error(z, u, depth: float, g_along: float, nu: float) -> float:
+    """sqrt(mean (u - u_film(z))^2) / u_film(H): particles' velocity error against ``film``,
+    relative to the exact surface velocity g H^2 / (2 nu)."""
+    err = np.asarray(u, dtype=float) - film(z, depth, g_along, nu)
+    return float(np.sqrt(np.mean(err ** 2)) / (g_along / nu * 0.5 * depth * depth))
+
+
 def herschel_bulkley_channel(y, L: float, F: float, rho: float, tau_y: float, K: float, n: float):
     """Steady plane Poiseuille flow of a Herschel-Bulkley fluid between plates at y = 0 and
     y = L, body force F per unit mass. The stress grows linearly from the centre,

@@ -345,11 +345,8 @@ def film_error(sim) -> float:
     """RMS of u - u_exact over the fluid particles, over the exact surface velocity (SPEC
     section 7's semi-parabolic profile)."""
     f = sim.kind[:sim.n_active] == 0
-    z, u = sim.z[:sim.n_active][f], sim.u[:sim.n_active][f]
-    H = 0.01876
-    g_along = sim.scene.gravity[0]
-    ue = exact.film(z, H, g_along, sim.scene.nu)
-    return float(np.sqrt(np.mean((u - ue) ** 2)) / exact.film(np.array([H]), H, g_along, sim.scene.nu)[0])
+    return exact.film_rms_error(sim.z[:sim.n_active][f], sim.u[:sim.n_active][f], 0.01876,
+                                sim.scene.gravity[0], sim.scene.nu)
 
 
 @pytest.mark.slow
