@@ -26,7 +26,6 @@ monitor's ``sample`` extended (the module's FrontMonitor replaced for this proce
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
@@ -85,20 +84,11 @@ def analyse_runs(paths, start: float) -> None:
             print(row(f"{name}: equivalent front", wander(t, ds.front_equivalent.values, ub, start), dp))
 
 
-def last_crossing(xg, v, level: float) -> float:
-    """The largest x on the grid xg where v falls through ``level`` (linear between nodes)."""
-    above = np.flatnonzero(v >= level)
-    if not above.size or above[-1] + 1 >= xg.size:
-        return math.nan
-    k = above[-1]
-    return float(xg[k] + (v[k] - level) / (v[k] - v[k + 1]) * (xg[k + 1] - xg[k]))
-
-
 def run_estimators(case_path: str, sets, out: str) -> None:
     from solver import front
     from solver.cli import apply_overrides
     from solver.conveyor import case_from_dict
-    from solver.probes import FieldSampler
+    from solver.probes import FieldSampler, last_crossing
     from solver.scene import read_yaml
 
     case = case_from_dict(apply_overrides(read_yaml(case_path) or {}, sets))

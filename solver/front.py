@@ -18,7 +18,7 @@ from . import film_depth, film_fit, steady
 from .build import build_particles
 from .conveyor import ConveyorCase, build_scene, lubrication_velocity, scheme_fluid
 from .output import to_dataset
-from .probes import C_SURFACE, FieldSampler, toe_position
+from .probes import C_SURFACE, FieldSampler, last_crossing, toe_position
 from .run import Runner
 from .simulation import Simulation
 from .sources import source_hash
@@ -132,11 +132,7 @@ class FrontMonitor:
                                                c.probes.uniform_zone[0])
         # front position: the most downstream point where the surface is at half h_n (far less
         # noisy than the toe, which jumps by dp as particles join or leave the tip)
-        above = np.flatnonzero(zs >= 0.5 * hn)
-        front = math.nan
-        if above.size and above[-1] + 1 < xs.size:
-            k = above[-1]
-            front = float(xs[k] + (zs[k] - 0.5 * hn) / (zs[k] - zs[k + 1]) * (xs[k + 1] - xs[k]))
+        front = last_crossing(xs, zs, 0.5 * hn)
         x_lab = toe - self.x_star * hn
         surface = np.interp(x_lab, xs, zs, left=np.nan, right=0.0)
         lo, hi = c.probes.uniform_zone

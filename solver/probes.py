@@ -178,6 +178,16 @@ def disorder_moments(idx, x, z, rho, mass, cl, h, out):
         out[2, k] = h * math.sqrt(gx * gx + gz * gz)
 
 
+def last_crossing(xs, v, level: float) -> float:
+    """The largest x on the ascending grid xs where v falls through ``level`` (linear between
+    nodes); NaN where v never reaches it or is still at it on the last node."""
+    above = np.flatnonzero(v >= level)
+    if not above.size or above[-1] + 1 >= xs.size:
+        return math.nan
+    k = above[-1]
+    return float(xs[k] + (v[k] - level) / (v[k] - v[k + 1]) * (xs[k + 1] - xs[k]))
+
+
 def toe_position(xf: np.ndarray, dp: float, gap_bins: int = 2) -> float:
     """Downstream end of the fluid body (see module docstring)."""
     if xf.size == 0:
