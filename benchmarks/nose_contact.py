@@ -7,7 +7,9 @@ particle + dp/2), and the mean pressure of the belt's top particle row (z in (-d
 ``--from`` on it prints their means, the pressure's excess over the hydrostatic head of the
 column above that row, rho0 |g_n| (surface - z_row), and for scale the viscous pressure of a
 moving contact line, mu u_b / r (Huh and Scriven 1971: p ~ mu U / r, r the distance from the
-contact line, here the column's centre behind the toe), and the toe's rms about its line.
+contact line, here the column's centre behind the toe; mu the case's Newtonian viscosity), the
+share of samples in which the belt row sits at the floor of the mDBC density (rho0, p = 0: no
+fluid pressing on it), and the toe's rms about its line.
 
 ``--no-shift-at-wall-surface`` replaces the Skillen shift (for this process only) by one that
 leaves unshifted the particles near a free surface (div r < 1.9) within reach of a wall (the
@@ -124,14 +126,16 @@ def analyse(path: str, start: float) -> None:
     lifted = np.nanmean(d["lowest"][m] > dp, 0)
     surface = np.nanmean(d["surface"][m], 0)
     wall_p = np.nanmean(d["wall_p"][m], 0)
+    floor = np.mean(d["wall_p"][m] <= 0.0, 0)  # the mDBC density floor rho0: no fluid pressing
     head = rho0 * g_n * np.nanmean(d["surface"][m] + 0.5 * dp, 0)  # the top row's centres lie at -dp/2
     print(f"{Path(path).name}: {m.sum()} samples from {start:g} s; toe rms about its line {res.std() / dp:.2f} dp")
     print("| column centre behind the toe [dp] | lowest fluid [dp] | share with lowest > 1 dp | surface [dp] | "
-          "belt row p [Pa] | hydrostatic head [Pa] | excess [Pa] | mu u_b / r [Pa] |")
-    print("|---|---|---|---|---|---|---|---|")
+          "belt row p [Pa] | share with it at its floor (p = 0) | hydrostatic head [Pa] | excess [Pa] | "
+          "mu u_b / r [Pa] |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for c in range(COLUMNS):
         print(f"| {r[c] / dp:.1f} | {lowest[c] / dp:.2f} | {lifted[c]:.2f} | {surface[c] / dp:.2f} | {wall_p[c]:.0f} | "
-              f"{head[c]:.0f} | {wall_p[c] - head[c]:.0f} | {mu * ub / r[c]:.0f} |")
+              f"{floor[c]:.2f} | {head[c]:.0f} | {wall_p[c] - head[c]:.0f} | {mu * ub / r[c]:.0f} |")
 
 
 def main(argv=None) -> int:
