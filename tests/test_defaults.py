@@ -14,6 +14,7 @@ import pytest
 import yaml
 
 from solver.conveyor import case_from_dict
+import study.config as cfgmod
 from study.config import SOLVER_KEYS, load_schema
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -119,6 +120,21 @@ def test_paper_config_pins_the_default_case():
     assert physical, "paper.yaml pins no physical key"
     for p, v in physical.items():
         assert _plain(_attr(DEFAULT_CASE, p)) == v, ".".join(p)
+
+
+def test_default_campaign_runs_the_paper_grid_scheme_with_a_smaller_step_coarser_than_1mm():
+    """Every case of config/config.yaml takes paper.yaml's scheme, so that its dp = 1 mm run is
+    the paper grid's; coarser than 1 mm C_CFL is 0.4 (C = 0.6 diverged at dp = 2.25 mm,
+    docs/conveyor.md, "The default campaign on the paper grid's scheme"). cfl_viscous is left
+    out: the sub-stepped laminar term has no viscous limit to read it for."""
+    paper = yaml.safe_load((ROOT / "config" / "paper.yaml").read_text())["case"]
+    cfg = cfgmod.validate(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
+    for case in cfgmod.cases(cfg):
+        d = cfgmod.case_dict(cfg, case)
+        want = {k: paper.get(k) for k in SCHEME_KEYS - {"cfl_viscous"}}
+        if case.dp > 1e-3:
+            want["cfl"] = 0.4
+        assert {k: d.get(k) for k in want} == want, case.id
 
 
 def test_paper_config_runs_the_fast_example_scheme():
