@@ -8,7 +8,9 @@ are the run's own) and prints a Markdown table of the functions with the most ow
 step. Then, from a second run without the profiler, the particle-steps/s of its time
 stepping (the run's own loop: probes, monitors, guards included, the start-up not) beside
 the throughput layer's (benchmarks/throughput.py) at the same particle count, Ch and
-method, and the start-up's wall time (the scene and the start's periodic film) apart.
+method, once with the layer's SPEC scheme and once with the case's (its physics, C_CFL and
+sound speed c0, so that the step and the RKC stage count match), and the start-up's wall
+time (the scene and the start's periodic film) apart.
 
 Usage: python benchmarks/profile_case.py [--case FILE] [--time 0.4] [--threads 2] [--set shifting=skillen]
            [--rows 14] [--steps-layer 400]
@@ -78,11 +80,25 @@ def main(argv=None):
     total = time.perf_counter() - tic
     stepping = float(ds.attrs["wall_time_s"])
     rate = n * int(ds.attrs["steps"]) / stepping
-    layer = measure(case.ch, a.threads, case.shifting, a.steps_layer, n)
+    stages = float(ds.attrs.get("rkc_stages", 0)) / int(ds.attrs["steps"])
     print(f"\nconveyor run (not profiled): {rate / 1e6:.2f} M particle-steps/s over its {stepping:.1f} s "
-          f"of time stepping, start-up {total - stepping:.1f} s apart; throughput layer at "
-          f"{layer['particles']} particles, same Ch and method: "
+          f"of time stepping ({stages:.2f} RKC stages a step), start-up {total - stepping:.1f} s apart")
+    layer = measure(case.ch, a.threads, case.shifting, a.steps_layer, n)
+    print(f"throughput layer at {layer['particles']} particles, same Ch and method, SPEC's scheme: "
           f"{layer['particle_steps_per_s'] / 1e6:.2f} M; ratio {rate / layer['particle_steps_per_s']:.2f}")
+    layer = measure(case.ch, a.threads, case.shifting, a.steps_layer, n, case_scheme(case))
+    print(f"throughput layer with the case's scheme (physics, C_CFL, c0; "
+          f"{layer['rkc_stages_per_step']:.2f} RKC stages a step): "
+          f"{layer['particle_steps_per_s'] / 1e6:.2f} M; ratio {rate / layer['particle_steps_per_s']:.2f}")
+
+
+def case_scheme(case) -> dict:
+    """The scene keys of a conveyor case's scheme, for the throughput layer: its physics, its
+    C_CFL and its sound speed c0 (so that the layer's step and RKC stage count match)."""
+    from solver.conveyor import build_scene, build_scene_dict
+    d = build_scene_dict(case)
+    return {"physics": d["physics"], "cfl": d["cfl"], "cfl_viscous": d["cfl_viscous"],
+            "sound": {"c0": build_scene(case).c0}}
 
 
 if __name__ == "__main__":

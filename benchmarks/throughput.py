@@ -73,9 +73,12 @@ def array_bytes(sim: Simulation) -> int:
     return total
 
 
-def measure(ch: float, threads: int, shifting: str, steps: int, particles: int) -> dict:
+def measure(ch: float, threads: int, shifting: str, steps: int, particles: int,
+            scheme: dict | None = None) -> dict:
+    """Time ``steps`` steps of the layer. ``scheme``: scene keys (``physics``, ``cfl``,
+    ``cfl_viscous``, ``sound``) that replace the layer's, to time another case's scheme."""
     numba.set_num_threads(threads)
-    sim = Simulation(scene_from_dict(layer_scene(ch, shifting, particles)))
+    sim = Simulation(scene_from_dict({**layer_scene(ch, shifting, particles), **(scheme or {})}))
     for _ in range(5):  # warm-up (compilation is cached after the first configuration)
         sim.step()
     tic = time.perf_counter()
@@ -89,6 +92,7 @@ def measure(ch: float, threads: int, shifting: str, steps: int, particles: int) 
             "particle_steps_per_s": round(sim.n * steps / wall),
             "ns_per_particle_step": round(1e9 * wall / (sim.n * steps), 1),
             "steps_per_s": round(steps / wall, 1),
+            "rkc_stages_per_step": round(sim.rkc_stages / (steps + 5), 2),
             "bytes_per_particle": round(array_bytes(sim) / sim.n)}
 
 
