@@ -30,6 +30,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 COLUMNS = 14
 FIELDS = ("lowest", "surface", "wall_p")
@@ -82,36 +83,25 @@ def skillen_without_wall_surface_shift():
 
 
 def run(case_path: str, sets, out: str, no_wall_surface_shift: bool) -> None:
-    from solver import front, shifting
-    from solver.cli import apply_overrides
-    from solver.conveyor import case_from_dict
-    from solver.scene import read_yaml
+    from sampled_run import load_case, report, run_sampled
+    from solver import shifting
 
-    case = case_from_dict(apply_overrides(read_yaml(case_path) or {}, sets))
+    case = load_case(case_path, sets)
     if no_wall_surface_shift:
         if case.shifting != "skillen":
             raise ValueError("--no-shift-at-wall-surface: applies to shifting skillen only")
         shifting.skillen_shift = skillen_without_wall_surface_shift()
-    series: dict[str, list] = {"t": [], "toe": [], **{k: [] for k in FIELDS}}
 
-    class NoseMonitor(front.FrontMonitor):
-        def sample(self, sim):
-            d = super().sample(sim)
-            n = sim.n_active
-            got = column_stats(sim.x[:n], sim.z[:n], sim.kind[:n], sim.p[:n], d["toe"], sim.scene.dp)
-            series["t"].append(sim.t)
-            series["toe"].append(d["toe"])
-            for k in FIELDS:
-                series[k].append(got[k])
-            return d
+    def columns(sim, d, case) -> dict:
+        n = sim.n_active
+        got = column_stats(sim.x[:n], sim.z[:n], sim.kind[:n], sim.p[:n], d["toe"], sim.scene.dp)
+        return {"t": sim.t, "toe": d["toe"], **{k: got[k] for k in FIELDS}}
 
-    front.FrontMonitor = NoseMonitor
-    ds = front.run_front(case, quiet=True)
+    ds, series = run_sampled(case, columns)
     g_n = case.gravity * math.cos(math.radians(case.slope_deg))  # bed-normal gravity
     np.savez(out, dp=case.dp, ub=case.belt.speed, mu=case.viscosity, rho0=case.density, g_n=g_n,
-             **{k: np.asarray(v) for k, v in series.items()})
-    print(f"{case.name}: {ds.attrs['status']} at {ds.attrs['simulated_time_s']:.2f} s, "
-          f"{ds.attrs['wall_time_s']:.0f} s wall -> {out}", file=sys.stderr)
+             **series)
+    report(case, ds, out)
 
 
 def analyse(path: str, start: float) -> None:

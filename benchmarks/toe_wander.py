@@ -17,7 +17,7 @@ x where the kernel concentration of the fluid (``cf``) or of all particles (``ca
 z = a dp crosses half-way between its value in the uniform zone (or beyond the tip, ``ca``)
 and zero, for a = 0.5, 1, 2, and where the free surface z_max stands at 1, 2 or 4 dp (``s``).
 Each is then analysed as the toe is. The run goes through ``solver.front.run_front`` with its
-monitor's ``sample`` extended (the module's FrontMonitor replaced for this process only).
+monitor's ``sample`` extended (benchmarks/sampled_run.py).
 
     python benchmarks/toe_wander.py results/s32/sub06-skillen-20s.nc results/s32/sub06-lind-20s.nc
     python benchmarks/toe_wander.py --estimators examples/conveyor_fast.yaml --set steady.stop=false \\
@@ -33,6 +33,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from solver.steady import trend_bound  # noqa: E402
 
@@ -85,40 +86,30 @@ def analyse_runs(paths, start: float) -> None:
 
 
 def run_estimators(case_path: str, sets, out: str) -> None:
-    from solver import front
-    from solver.cli import apply_overrides
-    from solver.conveyor import case_from_dict
+    from sampled_run import load_case, report, run_sampled
     from solver.probes import FieldSampler, last_crossing
-    from solver.scene import read_yaml
 
-    case = case_from_dict(apply_overrides(read_yaml(case_path) or {}, sets))
-    series: dict[str, list] = {}
+    case = load_case(case_path, sets)
 
-    class ToeMonitor(front.FrontMonitor):
-        def sample(self, sim):
-            d = super().sample(sim)
-            dp, hn, toe = sim.scene.dp, self.case.h_n, d["toe"]
-            fs = FieldSampler(sim)
-            xg = np.arange(toe - 10.0 * dp, toe + 3.0 * dp, 0.05 * dp)
-            x_in = toe - np.linspace(*self.case.probes.uniform_zone, 7) * hn
-            got = {"t": sim.t, "toe": toe, "front_equivalent": d["front_equivalent"]}
-            for name, a in LINES:
-                line = fs.points(xg, np.full(xg.size, a * dp))
-                c_in = float(np.mean(fs.points(x_in, np.full(x_in.size, a * dp))[1]))
-                got[f"cf_{name}"] = last_crossing(xg, line[1], 0.5 * c_in)
-                got[f"ca_{name}"] = last_crossing(xg, line[0], 0.5 * (1.0 + line[0][-1]))
-            zs = fs.surface(xg, 0.0)
-            for name, a in LEVELS:
-                got[name] = last_crossing(xg, zs, a * dp)
-            for k, v in got.items():
-                series.setdefault(k, []).append(v)
-            return d
+    def estimators(sim, d, case) -> dict:
+        dp, hn, toe = sim.scene.dp, case.h_n, d["toe"]
+        fs = FieldSampler(sim)
+        xg = np.arange(toe - 10.0 * dp, toe + 3.0 * dp, 0.05 * dp)
+        x_in = toe - np.linspace(*case.probes.uniform_zone, 7) * hn
+        got = {"t": sim.t, "toe": toe, "front_equivalent": d["front_equivalent"]}
+        for name, a in LINES:
+            line = fs.points(xg, np.full(xg.size, a * dp))
+            c_in = float(np.mean(fs.points(x_in, np.full(x_in.size, a * dp))[1]))
+            got[f"cf_{name}"] = last_crossing(xg, line[1], 0.5 * c_in)
+            got[f"ca_{name}"] = last_crossing(xg, line[0], 0.5 * (1.0 + line[0][-1]))
+        zs = fs.surface(xg, 0.0)
+        for name, a in LEVELS:
+            got[name] = last_crossing(xg, zs, a * dp)
+        return got
 
-    front.FrontMonitor = ToeMonitor
-    ds = front.run_front(case, quiet=True)
-    np.savez(out, ub=case.belt.speed, dp=case.dp, **{k: np.asarray(v) for k, v in series.items()})
-    print(f"{case.name}: {ds.attrs['status']} at {ds.attrs['simulated_time_s']:.2f} s, "
-          f"{ds.attrs['wall_time_s']:.0f} s wall -> {out}", file=sys.stderr)
+    ds, series = run_sampled(case, estimators)
+    np.savez(out, ub=case.belt.speed, dp=case.dp, **series)
+    report(case, ds, out)
 
 
 def analyse_estimators(path: str, start: float) -> None:
