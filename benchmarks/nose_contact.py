@@ -15,6 +15,14 @@ fluid pressing on it), and the toe's rms about its line.
 leaves unshifted the particles near a free surface (div r < 1.9) within reach of a wall (the
 kernel-weighted wall-normal sum non-zero), which includes the nose's contact with the belt.
 
+``--slip-near-toe L`` lets the belt slip (for this process only) from L dp behind the toe
+forward: after the mDBC update, a belt particle there takes the tangential velocity
+u_b = u_wall + beta (u_wall - u_g) instead of its no-slip mirror 2 u_wall - u_g (beta 1), u_g
+the ghost node's; ``--slip-beta`` sets beta (-1, the default: free slip, u_b = u_g; 0: the
+wall's own velocity). The normal component stays mirrored. The toe is the monitor's, updated
+with every probe sample. A slip patch at the contact line is the usual regularisation of the
+moving contact line's stress singularity; SPEC and the paper have a no-slip belt.
+
     python benchmarks/nose_contact.py examples/conveyor_fast.yaml --set steady.stop=false \\
         --set steady.max_time=6 -o results/nose.npz [--no-shift-at-wall-surface]
     python benchmarks/nose_contact.py --analyse results/nose.npz [--from 3]
@@ -26,6 +34,7 @@ import math
 import sys
 from pathlib import Path
 
+import numba as nb
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -56,8 +65,6 @@ def column_stats(x, z, kind, p, toe: float, dp: float, columns: int = COLUMNS) -
 
 def skillen_without_wall_surface_shift():
     """``shifting.skillen_shift`` but no shift where div r < 1.9 within reach of a wall."""
-    import numba as nb
-
     from solver.shifting import _off_wall
 
     @nb.njit(parallel=True)
@@ -82,7 +89,37 @@ def skillen_without_wall_surface_shift():
     return skillen_shift
 
 
-def run(case_path: str, sets, out: str, no_wall_surface_shift: bool) -> None:
+@nb.njit(parallel=True, cache=True)
+def _slip_tangential(x, u, kind, wall, vwall, n_active, belt, x_from, beta):
+    """Belt particles at x > x_from: u = u_wall + beta (u_wall - u_g), u_g = 2 u_wall - u the
+    ghost velocity the mDBC mirrored (beta 1: no slip, unchanged; 0: u_wall; -1: free slip)."""
+    for i in nb.prange(n_active):
+        if kind[i] == 1 and wall[i] == belt and x[i] > x_from:
+            vw = vwall[belt, 0]
+            u[i] = vw + beta * (u[i] - vw)
+
+
+def mdbc_with_slip_near_toe(state: dict):
+    """``boundary.make_mdbc_update`` whose update then frees the belt's tangential velocity at
+    x > state["x_from"] by state["beta"] (belt: wall index state["belt"])."""
+    from solver import boundary
+
+    shipped_make = boundary.make_mdbc_update
+
+    def make(*args, **kwargs):
+        shipped = shipped_make(*args, **kwargs)
+
+        def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, *rest):
+            shipped(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, *rest)
+            _slip_tangential(x, u, kind, wall, vwall, n_active, state["belt"], state["x_from"], state["beta"])
+
+        return mdbc_update
+
+    return make
+
+
+def run(case_path: str, sets, out: str, no_wall_surface_shift: bool, slip_near_toe: float | None = None,
+        slip_beta: float = -1.0) -> None:
     from sampled_run import load_case, report, run_sampled
     from solver import shifting
 
@@ -91,8 +128,15 @@ def run(case_path: str, sets, out: str, no_wall_surface_shift: bool) -> None:
         if case.shifting != "skillen":
             raise ValueError("--no-shift-at-wall-surface: applies to shifting skillen only")
         shifting.skillen_shift = skillen_without_wall_surface_shift()
+    slip = {"belt": 0, "x_from": math.inf, "beta": slip_beta}  # no slip until the first sample gives the toe
+    if slip_near_toe is not None:
+        from solver import boundary
+        boundary.make_mdbc_update = mdbc_with_slip_near_toe(slip)
 
     def columns(sim, d, case) -> dict:
+        slip["belt"] = [wl.name for wl in sim.scene.walls].index("belt")
+        if slip_near_toe is not None:
+            slip["x_from"] = d["toe"] - slip_near_toe * sim.scene.dp
         n = sim.n_active
         got = column_stats(sim.x[:n], sim.z[:n], sim.kind[:n], sim.p[:n], d["toe"], sim.scene.dp)
         return {"t": sim.t, "toe": d["toe"], **{k: got[k] for k in FIELDS}}
@@ -109,6 +153,9 @@ def analyse(path: str, start: float) -> None:
     dp, ub, mu, rho0, g_n = (float(d[k]) for k in ("dp", "ub", "mu", "rho0", "g_n"))
     t = d["t"]
     m = t >= start - 1e-9
+    if m.sum() < 2:
+        print(f"{Path(path).name}: fewer than 2 samples from {start:g} s (the run ends at {t[-1]:.2f} s)")
+        return
     toe = d["toe"][m]
     res = toe - np.polyval(np.polyfit(t[m], toe, 1), t[m])
     r = (np.arange(COLUMNS) + 0.5) * dp
@@ -135,6 +182,11 @@ def main(argv=None) -> int:
     ap.add_argument("-o", "--out", default="nose_contact.npz")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--no-shift-at-wall-surface", action="store_true")
+    ap.add_argument("--slip-near-toe", type=float, metavar="L",
+                    help="slip on the belt from L dp behind the toe forward")
+    ap.add_argument("--slip-beta", type=float, default=-1.0,
+                    help="there u_b = u_wall + beta (u_wall - u_g): -1 free slip (default), "
+                         "0 the wall's velocity, 1 no slip")
     ap.add_argument("--analyse", nargs="*", default=[], metavar="NPZ", help="analyse earlier runs")
     ap.add_argument("--from", dest="start", type=float, default=3.0, help="first second analysed")
     a = ap.parse_args(argv)
@@ -144,7 +196,7 @@ def main(argv=None) -> int:
         from solver.scene import SceneError
         numba.set_num_threads(a.threads)
         try:
-            run(a.case, a.set, a.out, a.no_shift_at_wall_surface)
+            run(a.case, a.set, a.out, a.no_shift_at_wall_surface, a.slip_near_toe, a.slip_beta)
         except (SceneError, OSError, ValueError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2

@@ -45,6 +45,8 @@ def run_sampled(case, sample: Callable) -> tuple:
 
 
 def report(case, ds, out: str) -> None:
-    """One line on stderr: the run's status, simulated time, wall time and output file."""
+    """One line on stderr: the run's status, simulated time, wall time and output file, and the
+    reason of a run that diverged."""
+    why = f" ({ds.attrs.get('reason', '')})" if ds.attrs["status"] == "diverged" else ""
     print(f"{case.name}: {ds.attrs['status']} at {ds.attrs['simulated_time_s']:.2f} s, "
-          f"{ds.attrs['wall_time_s']:.0f} s wall -> {out}", file=sys.stderr)
+          f"{ds.attrs['wall_time_s']:.0f} s wall -> {out}{why}", file=sys.stderr)
