@@ -134,8 +134,9 @@ def run(case_path: str, sets, out: str, no_wall_surface_shift: bool, slip_near_t
         boundary.make_mdbc_update = mdbc_with_slip_near_toe(slip)
 
     def columns(sim, d, case) -> dict:
-        slip["belt"] = [wl.name for wl in sim.scene.walls].index("belt")
         if slip_near_toe is not None:
+            if math.isinf(slip["x_from"]):  # the first sample: find the belt once
+                slip["belt"] = [wl.name for wl in sim.scene.walls].index("belt")
             slip["x_from"] = d["toe"] - slip_near_toe * sim.scene.dp
         n = sim.n_active
         got = column_stats(sim.x[:n], sim.z[:n], sim.kind[:n], sim.p[:n], d["toe"], sim.scene.dp)
