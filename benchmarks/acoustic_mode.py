@@ -1,0 +1,67 @@
+"""The step's amplification of one linear acoustic mode, and the damping it needs.
+
+One mode of the linearised acoustic pair rho' = -omega v - d rho, v' = omega rho - g v (scaled
+density and velocity; d from the density diffusion, g from the laminar term) under the solver's
+step (solver/simulation.py, ``step``; solver/integrate.py):
+- the density drifts half a step with the previous step's rate, rho_h = rho^n + dt/2 D^{n-1};
+- one evaluation at the half step: D = -omega v^n - d rho_h, and the pressure force omega rho_h;
+- v^{n+1} = exp(-g dt) v^n + dt omega rho_h (the laminar term damped as the sub-stepped
+  update damps it, or ``--explicit-viscosity``: (1 - g dt) v^n), rho^{n+1} = rho^n + dt D.
+With a = omega dt, b = g dt, e = d dt it prints the spectral radius of the step's
+amplification matrix on (rho, v, dt D^{n-1}) for b = e = 0 (above 1: the undamped mode grows),
+and the least damping per step, b alone or e alone, that brings the radius to 1.
+
+Usage: python benchmarks/acoustic_mode.py [--a 0.2 0.4 0.6 0.8 1.0 1.2]
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+
+def radius(a: float, b: float = 0.0, e: float = 0.0, explicit_viscosity: bool = False) -> float:
+    """Spectral radius of one step on (rho, v, dt D_prev)."""
+    m = np.empty((3, 3))
+    for col in range(3):
+        rho, v, q = np.eye(3)[col]
+        rho_h = rho + 0.5 * q
+        dtd = -a * v - e * rho_h
+        damp = (1.0 - b) if explicit_viscosity else np.exp(-b)
+        m[:, col] = (rho + dtd, damp * v + a * rho_h, dtd)
+    return float(max(abs(np.linalg.eigvals(m))))
+
+
+def least_damping(a: float, which: str, explicit_viscosity: bool = False) -> float:
+    """Least b (which = "b") or e ("e") per step with radius <= 1: the first crossing found by
+    steps of 0.01 from 0 (too much damping is unstable in its own right), then bisection."""
+    def r(x):
+        b, e = (x, 0.0) if which == "b" else (0.0, x)
+        return radius(a, b, e, explicit_viscosity)
+    x = 0.0
+    while r(x) > 1.0 + 1e-12:
+        x += 0.01
+        if x > 2.0:
+            return float("nan")
+    lo, hi = max(x - 0.01, 0.0), x
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if r(mid) > 1.0 + 1e-12 else (lo, mid)
+    return hi
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--a", type=float, nargs="+", default=[0.2, 0.4, 0.6, 0.8, 1.0, 1.2])
+    ap.add_argument("--explicit-viscosity", action="store_true")
+    args = ap.parse_args(argv)
+    print("| a = omega dt | radius, undamped | least b = g dt (e = 0) | least e = d dt (b = 0) |")
+    print("|---|---|---|---|")
+    for a in args.a:
+        print(f"| {a:g} | {radius(a, explicit_viscosity=args.explicit_viscosity):.4f} | "
+              f"{least_damping(a, 'b', args.explicit_viscosity):.4f} | "
+              f"{least_damping(a, 'e', args.explicit_viscosity):.4f} |")
+
+
+if __name__ == "__main__":
+    main()
