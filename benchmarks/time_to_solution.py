@@ -71,6 +71,9 @@ VARIANTS = {
     # the example (its laminar term sub-stepped, no viscous limit on dt) at other acoustic C
     **{f"fast_substepped_cfl_{c}": example_overrides("conveyor_fast") + ["viscous_update=substepped", f"cfl={c}"]
        for c in ("0.5", "0.6", "0.7")},
+    # the example with the leapfrog density update (docs/numerics.md) at acoustic C
+    **{f"fast_leapfrog_cfl_{c}": example_overrides("conveyor_fast") + ["density_update=leapfrog", f"cfl={c}"]
+       for c in ("0.6", "0.8", "1.0")},
 }
 
 

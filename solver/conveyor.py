@@ -15,7 +15,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import lubrication, viscoplastic
-from .scene import NEAR_SURFACE, VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into, scene_from_dict
+from .scene import (DENSITY_UPDATES, NEAR_SURFACE, VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into,
+                    scene_from_dict)
 from .steady import SteadyCriteria
 
 START_SHAPES = ("block", "lubrication", "warm")
@@ -100,6 +101,7 @@ class ConveyorCase(YamlData):
     viscous_correction: bool = False
     volume_relaxation: float | None = None
     viscous_update: str = "explicit"  # implicit or substepped: no viscous limit on dt; auto(_substepped): where it pays
+    density_update: str = "explicit"  # leapfrog: the density's second half step at v^{n+1}
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
@@ -187,6 +189,9 @@ def validate_case(c: ConveyorCase) -> None:
     if c.viscous_update not in VISCOUS_UPDATES:
         raise SceneError(f"case.viscous_update: {c.viscous_update!r} is not one of "
                          f"{', '.join(VISCOUS_UPDATES)}")
+    if c.density_update not in DENSITY_UPDATES:
+        raise SceneError(f"case.density_update: {c.density_update!r} is not one of "
+                         f"{', '.join(DENSITY_UPDATES)}")
     if not 0 < c.slope_deg < 90:
         raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
     if c.start not in START_SHAPES:
@@ -348,7 +353,8 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
                     "density_diffusion_reference": c.density_diffusion_reference,
                     "viscous_correction": c.viscous_correction,
                     "volume_relaxation": c.volume_relaxation,
-                    "viscous_update": c.viscous_update, "shifting": shifting},
+                    "viscous_update": c.viscous_update, "density_update": c.density_update,
+                    "shifting": shifting},
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,

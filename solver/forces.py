@@ -489,6 +489,48 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     return pair_loop
 
 
+@nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
+def continuity_of_change(x, z, du, dw, rho, vol, kind, cl, h, out):
+    """out[a] = rho_a sum_b V_b (du_ab . gradW_ab), V_b = ``vol[b]`` = m_b / rho_b, for every
+    fluid a (0 on boundary rows): the continuity rate of the velocity change (du, dw), which the
+    leapfrog density update adds to the evaluation's rate (``Simulation.step``). Each fluid
+    particle gathers over the z window (z_a - 2h, z_a + 2h) of its column and the two beside it
+    and writes its own row only (``cells.CellList`` cl, columns at least 2h wide)."""
+    start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
+    fac = grad_coefficient(h)
+    four_h2 = 4.0 * h * h
+    two_h = 2.0 * h
+    inv_h = 1.0 / h
+    for ix in nb.prange(ncx):
+        for a in range(start[ix * ncz], start[(ix + 1) * ncz]):
+            if kind[a] != 0:
+                out[a] = 0.0
+                continue
+            xa, za, dua, dwa = x[a], z[a], du[a], dw[a]
+            s = 0.0
+            for c in range(3):  # the columns ix - 1, ix, ix + 1
+                jx = ix + c - 1
+                shift = 0.0
+                if jx < 0 or jx >= ncx:
+                    if not periodic:
+                        continue
+                    shift = -period if jx < 0 else period
+                    jx = jx + ncx if jx < 0 else jx - ncx
+                b0, b1 = start[jx * ncz], start[(jx + 1) * ncz]
+                column = z[b0:b1]  # sorted by z: the window is a range
+                lo = np.searchsorted(column, za - two_h) + b0
+                hi = np.searchsorted(column, za + two_h) + b0
+                xs = xa - shift
+                for b in range(np.uint64(lo), np.uint64(hi)):
+                    # no branch, so that the loop vectorises: beyond 2h the factor is 0
+                    dx = xs - x[b]
+                    dz = za - z[b]
+                    r2 = min(dx * dx + dz * dz, four_h2)
+                    t = 1.0 - 0.5 * math.sqrt(r2) * inv_h
+                    s += vol[b] * (fac * t * t * t) * ((dua - du[b]) * dx + (dwa - dw[b]) * dz)
+            out[a] = rho[a] * s
+
+
 @nb.njit(cache=True)
 def thread_bounds(start, split, ncx, ncz, periodic):
     """(lo, hi, wrap): thread t wrote particles [lo[t], hi[t]) (``thread_rows``) and, with a

@@ -64,6 +64,22 @@ def kick(u, w, rho, kind, ax, az, drho, drho_prev, n, dt, rho0, clamp_boundary, 
         drho_prev[i] = drho[i]
 
 
+@nb.njit(parallel=True, cache=True)
+def leapfrog_density(rho, rho_h, drho, ddrho, drho_prev, kind, n, dt, rho0, clamp_boundary, clamp_fluid):
+    """rho^{n+1} = rho_h + dt/2 (drho + ddrho), the continuity rate at v^{n+1} (the evaluation's
+    drho at v^n plus ``forces.continuity_of_change`` of the kick), which is also the next
+    step's half-step rate; floors as in ``kick``."""
+    for i in nb.prange(n):
+        d = drho[i] + ddrho[i]
+        rho[i] = rho_h[i] + 0.5 * dt * d
+        drho_prev[i] = d
+        if kind[i] == 0:
+            if clamp_fluid and rho[i] < rho0:
+                rho[i] = rho0
+        elif clamp_boundary and rho[i] < rho0:
+            rho[i] = rho0
+
+
 def viscous_cfl(cfl, cfl_viscous=None):
     """C_nu of the viscous limit: ``cfl_viscous``, or C when it is None (SPEC eq. 7's one C)."""
     return cfl if cfl_viscous is None else cfl_viscous

@@ -20,6 +20,7 @@ BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
 VISCOUS_UPDATES = ("explicit", "implicit", "substepped", "auto", "auto_substepped")
+DENSITY_UPDATES = ("explicit", "leapfrog")
 # auto: implicit where the explicit viscous step is at least this many times below the acoustic
 # one (an implicit step costs 2.7-3.5 explicit ones on the paper case at dp = 0.25 mm:
 # docs/numerics.md, "Implicit viscosity")
@@ -182,6 +183,10 @@ class Physics:
     # limit on dt), auto (implicit where it saves steps: Scene.implicit_viscosity) or
     # auto_substepped (substepped there)
     viscous_update: str = "explicit"
+    # explicit: rho^{n+1} = rho^n + dt drho/dt at v^n (the step's one evaluation); leapfrog: the
+    # density's second half step takes the continuity rate at v^{n+1} (a continuity-only pass
+    # over the pairs after the kick; docs/numerics.md, "The leapfrog density update")
+    density_update: str = "explicit"
     # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
     artificial_viscosity: float | None = None
     # floor the fluid density at rho0 after each step: no negative pressure, no tensile clumping
@@ -490,6 +495,9 @@ def validate(scene: Scene) -> None:
     if ph.viscous_update not in VISCOUS_UPDATES:
         raise SceneError(
             f"physics.viscous_update: {ph.viscous_update!r} is not one of {', '.join(VISCOUS_UPDATES)}")
+    if ph.density_update not in DENSITY_UPDATES:
+        raise SceneError(
+            f"physics.density_update: {ph.density_update!r} is not one of {', '.join(DENSITY_UPDATES)}")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
     if ph.artificial_viscosity is not None and not 0 <= ph.artificial_viscosity <= 1:

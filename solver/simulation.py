@@ -84,6 +84,7 @@ class Simulation:
         self.volume_slot = forces.volume_slot(True, self.correct_shift, self.viscous_correction,
                                               self.variable_viscosity, self.strain_correction)
         self.mdbc = s.physics.boundary == "mdbc"
+        self.leapfrog = s.physics.density_update == "leapfrog"  # the density at v^{n+1}: step()
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
                                  self.variable_viscosity, self.implicit, self.strain_correction,
                                  self.volume_relaxation > 0)
@@ -193,13 +194,7 @@ class Simulation:
         if reason:
             return reason
         s = self.scene
-        vwall = self.wall_velocities(t)
-        if self.mdbc:
-            self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
-                             self.wall, self.gx, self.gz, vwall, self.cells, self.n_active,
-                             self.h, self.rho0, s.dp * s.dp, self.n_lattice)
-        else:
-            boundary.dbc_velocity(self.kind, self.wall, vwall, self.u, self.w, self.n_active)
+        self._set_walls(t)
         forces.pressure_and_inverse_density(self.rho, self.p, self.irho, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
@@ -224,6 +219,31 @@ class Simulation:
         if self.correct_shift:
             self._correct_density()
         return ""
+
+    def _set_walls(self, t: float):
+        """Wall particles' velocity (and, with mDBC, density) from the fluid at time t."""
+        if self.mdbc:
+            self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
+                             self.wall, self.gx, self.gz, self.wall_velocities(t), self.cells,
+                             self.n_active, self.h, self.rho0, self.scene.dp ** 2, self.n_lattice)
+        else:
+            boundary.dbc_velocity(self.kind, self.wall, self.wall_velocities(t), self.u, self.w,
+                                  self.n_active)
+
+    def _leapfrog_density(self, t: float, dt: float, u0, w0, rho_h):
+        """After the kick (velocities v^{n+1}, positions still those of the evaluation at t):
+        rho^{n+1} = rho_h + dt/2 drho/dt at v^{n+1}, the evaluation's rate at v^n plus the
+        continuity rate of the velocity change, the walls' included (set again from the
+        kicked fluid)."""
+        n = self.n_active
+        self._set_walls(t)
+        du, dw = self.u - u0, self.w - w0
+        change = np.empty(self.n)
+        forces.continuity_of_change(self.x, self.z, du, dw, rho_h, self.mass / rho_h, self.kind,
+                                    self.cells, self.h, change)
+        integrate.leapfrog_density(self.rho, rho_h, self.out[forces.DRHO], change, self.drho_prev,
+                                   self.kind, n, dt, self.rho0, not self.mdbc,
+                                   bool(self.scene.physics.no_tension))
 
     def viscous_operator(self) -> tuple:
         """The laminar operator C of the last evaluation (``implicit.operator``)."""
@@ -331,9 +351,13 @@ class Simulation:
         if self.volume_relaxation:
             self._relax_volume(dt)
         o = self.out
+        if self.leapfrog:
+            u0, w0, rho_h = self.u.copy(), self.w.copy(), self.rho.copy()
         integrate.kick(self.u, self.w, self.rho, self.kind, o[forces.AX], o[forces.AZ], o[forces.DRHO],
                        self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc,
                        bool(s.physics.no_tension))
+        if self.leapfrog:
+            self._leapfrog_density(t + 0.5 * dt, dt, u0, w0, rho_h)
         vw = self.wall_velocities(t + dt)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
                         vw, self.moving, 0.5 * dt, self.n)

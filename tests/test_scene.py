@@ -45,6 +45,8 @@ def test_impossible_values():
     assert "physics.shifting.method" in err({"physics": {"shifting": {"method": "magic"}}})
     assert "none, skillen, lind" in err({"physics": {"shifting": {"method": "magic"}}})
     assert "physics.boundary" in err({"physics": {"boundary": "slip"}})
+    assert "physics.density_update: 'verlet' is not one of explicit, leapfrog" in err(
+        {"physics": {"density_update": "verlet"}})
     assert "physics.shifting.min_speed: must be a finite number >= 0" in err(
         {"physics": {"shifting": {"method": "skillen", "min_speed": -0.1}}})
     assert "applies to method skillen only" in err(
