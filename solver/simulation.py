@@ -225,7 +225,7 @@ class Simulation:
         if self.mdbc:
             self.mdbc_update(self.x, self.z, self.u, self.w, self.rho, self.mass, self.kind,
                              self.wall, self.gx, self.gz, self.wall_velocities(t), self.cells,
-                             self.n_active, self.h, self.rho0, self.scene.dp ** 2, self.n_lattice)
+                             self.n_active, self.h, self.rho0, self.scene.dp * self.scene.dp, self.n_lattice)
         else:
             boundary.dbc_velocity(self.kind, self.wall, self.wall_velocities(t), self.u, self.w,
                                   self.n_active)
