@@ -23,29 +23,31 @@ import argparse
 import numpy as np
 
 
+def spectral_radius(step) -> float:
+    """Spectral radius of the linear map ``step(rho, v, q) -> (rho', v', q')`` on (rho, v, dt D)."""
+    m = np.array([step(*np.eye(3)[col]) for col in range(3)]).T
+    return float(max(abs(np.linalg.eigvals(m))))
+
+
 def radius(a: float, b: float = 0.0, e: float = 0.0, explicit_viscosity: bool = False) -> float:
-    """Spectral radius of one step on (rho, v, dt D_prev)."""
-    m = np.empty((3, 3))
-    for col in range(3):
-        rho, v, q = np.eye(3)[col]
+    """The solver's step: rho_h = rho^n + dt/2 D^{n-1}, D = -omega v^n - d rho_h."""
+    damp = (1.0 - b) if explicit_viscosity else np.exp(-b)
+
+    def step(rho, v, q):
         rho_h = rho + 0.5 * q
         dtd = -a * v - e * rho_h
-        damp = (1.0 - b) if explicit_viscosity else np.exp(-b)
-        m[:, col] = (rho + dtd, damp * v + a * rho_h, dtd)
-    return float(max(abs(np.linalg.eigvals(m))))
+        return rho + dtd, damp * v + a * rho_h, dtd
+    return spectral_radius(step)
 
 
 def leapfrog_radius(a: float) -> float:
-    """Undamped spectral radius of the leapfrog on (rho, v, dt D(v^n)): rho_h = rho^n + dt/2 D(v^n),
-    v^{n+1} = v^n + dt omega rho_h, rho^{n+1} = rho_h + dt/2 D(v^{n+1})."""
-    m = np.empty((3, 3))
-    for col in range(3):
-        rho, v, q = np.eye(3)[col]
+    """Undamped, the leapfrog: rho_h = rho^n + dt/2 D(v^n), v^{n+1} = v^n + dt omega rho_h,
+    rho^{n+1} = rho_h + dt/2 D(v^{n+1})."""
+    def step(rho, v, q):
         rho_h = rho + 0.5 * q
         v1 = v + a * rho_h
-        q1 = -a * v1
-        m[:, col] = (rho_h + 0.5 * q1, v1, q1)
-    return float(max(abs(np.linalg.eigvals(m))))
+        return rho_h - 0.5 * a * v1, v1, -a * v1
+    return spectral_radius(step)
 
 
 def least_damping(a: float, which: str, explicit_viscosity: bool = False) -> float:
