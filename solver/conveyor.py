@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import lubrication, viscoplastic
-from .scene import (DENSITY_UPDATES, NEAR_SURFACE, VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into,
+from .scene import (CFL_RULES, DENSITY_UPDATES, NEAR_SURFACE, VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into,
                     scene_from_dict)
 from .steady import SteadyCriteria
 
@@ -96,6 +96,7 @@ class ConveyorCase(YamlData):
     coefsound: float = 10.0
     cfl: float = 0.2
     cfl_viscous: float | None = None  # C of the viscous limit alone; null: cfl
+    cfl_rule: str = "fixed"  # damping: the acoustic C at most 0.9 times its damped edge (Scene.cfl_acoustic)
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False
@@ -189,6 +190,8 @@ def validate_case(c: ConveyorCase) -> None:
     if c.viscous_update not in VISCOUS_UPDATES:
         raise SceneError(f"case.viscous_update: {c.viscous_update!r} is not one of "
                          f"{', '.join(VISCOUS_UPDATES)}")
+    if c.cfl_rule not in CFL_RULES:
+        raise SceneError(f"case.cfl_rule: {c.cfl_rule!r} is not one of {', '.join(CFL_RULES)}")
     if c.density_update not in DENSITY_UPDATES:
         raise SceneError(f"case.density_update: {c.density_update!r} is not one of "
                          f"{', '.join(DENSITY_UPDATES)}")
@@ -348,6 +351,7 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
         "sound": {"coefsound": c.coefsound, "depth": hn},
         "cfl": c.cfl,
         "cfl_viscous": c.cfl_viscous,
+        "cfl_rule": c.cfl_rule,
         "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
                     "density_diffusion": c.density_diffusion,
                     "density_diffusion_reference": c.density_diffusion_reference,

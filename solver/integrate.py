@@ -85,15 +85,17 @@ def viscous_cfl(cfl, cfl_viscous=None):
     return cfl if cfl_viscous is None else cfl_viscous
 
 
-def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None, viscous_limit=True):
+def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None, viscous_limit=True, cfl_acoustic=None):
     """(dt, index of the limiting term, (dt1, dt2, dt3)) of SPEC eq. 7:
-    dt = min(C dt1, C dt2, C_nu dt3), C = ``cfl``, C_nu = ``cfl_viscous`` (default C, when
-    this is C min(dt1, dt2, dt3) as SPEC writes it). Without ``viscous_limit`` (an implicit
-    laminar term) dt = min(C dt1, C dt2); dt3 is still reported."""
+    dt = min(C dt1, C_a dt2, C_nu dt3), C = ``cfl``, C_a = ``cfl_acoustic`` (default C),
+    C_nu = ``cfl_viscous`` (default C; with both defaults this is C min(dt1, dt2, dt3) as SPEC
+    writes it). Without ``viscous_limit`` (an implicit laminar term) dt = min(C dt1, C_a dt2);
+    dt3 is still reported."""
     dt1 = math.sqrt(h / amax) if amax > 0 else math.inf
     dt2 = h / (c0 + vmax)
     dt3 = h * h / nu
     c_nu = viscous_cfl(cfl, cfl_viscous) if viscous_limit else math.inf
-    scaled = (cfl * dt1, cfl * dt2, c_nu * dt3)
+    c_a = cfl if cfl_acoustic is None else cfl_acoustic
+    scaled = (cfl * dt1, c_a * dt2, c_nu * dt3)
     k = int(np.argmin(scaled))
     return scaled[k], k, (dt1, dt2, dt3)

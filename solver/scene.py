@@ -21,6 +21,8 @@ MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
 VISCOUS_UPDATES = ("explicit", "implicit", "substepped", "auto", "auto_substepped")
 DENSITY_UPDATES = ("explicit", "leapfrog")
+CFL_RULES = ("fixed", "damping")
+MIN_DAMPED_CFL = 0.05  # below this acoustic C the damping rule refuses the scene
 # auto: implicit where the explicit viscous step is at least this many times below the acoustic
 # one (an implicit step costs 2.7-3.5 explicit ones on the paper case at dp = 0.25 mm:
 # docs/numerics.md, "Implicit viscosity")
@@ -235,6 +237,10 @@ class Scene(YamlData):
     gravity: tuple[float, float] = (0.0, -9.81)
     cfl: float = 0.2
     cfl_viscous: float | None = None  # C of the viscous limit dt3 alone; null: cfl (SPEC eq. 7)
+    # fixed: the acoustic limit's C is cfl (SPEC eq. 7); damping: at most 0.85 times the edge C* at
+    # which the laminar term and the density diffusion still damp the acoustic pair
+    # (solver/acoustic_edge.py; Scene.cfl_acoustic)
+    cfl_rule: str = "fixed"
     periodic_x: tuple[float, float] | None = None
     domain: Domain | None = None
     physics: Physics = field(default_factory=Physics)
@@ -259,6 +265,25 @@ class Scene(YamlData):
             return self.sound.c0
         g = math.hypot(*self.gravity)
         return self.sound.coefsound * math.sqrt(g * self.sound.depth)
+
+    @property
+    def acoustic_damping_ratio(self) -> float:
+        """r = nu / (c0 h): the laminar term's damping of an acoustic mode of given h k, per step
+        and per unit C, relative to its frequency (solver/acoustic_edge.py)."""
+        return self.nu / (self.c0 * self.h)
+
+    @property
+    def cfl_acoustic(self) -> float:
+        """C of the acoustic limit dt2: ``cfl``, or with ``cfl_rule: damping`` and the explicit
+        density update min(cfl, 0.85 C*(Ch, nu / (c0 h), delta)) (``acoustic_edge.damped_cfl``; the
+        laminar term's damping in its explicit form where ``viscous_update`` is explicit, else as
+        the sub-stepped update damps it). The leapfrog update keeps ``cfl``: its acoustic pair is
+        neutral (docs/numerics.md)."""
+        if self.cfl_rule == "fixed" or self.physics.density_update == "leapfrog":
+            return self.cfl
+        from .acoustic_edge import damped_cfl
+        return damped_cfl(self.cfl, self.ch, self.acoustic_damping_ratio, self.physics.density_diffusion,
+                          explicit_viscosity=self.physics.viscous_update == "explicit")
 
     @property
     def implicit_viscosity(self) -> bool:
@@ -456,6 +481,23 @@ def _validate_rheology(scene: Scene) -> None:
         raise SceneError("physics.viscous_correction: only for rheology newtonian")
 
 
+def _validate_cfl_rule(scene: Scene) -> None:
+    if scene.cfl_rule not in CFL_RULES:
+        raise SceneError(f"cfl_rule: {scene.cfl_rule!r} is not one of {', '.join(CFL_RULES)}")
+    if scene.cfl_rule == "fixed":
+        return
+    if not scene.fluid.newtonian:
+        raise SceneError("cfl_rule: damping needs one viscosity (rheology newtonian); a "
+                         f"{scene.fluid.rheology} fluid's laminar damping varies with its strain rate")
+    c = scene.cfl_acoustic
+    if c < MIN_DAMPED_CFL:
+        raise SceneError(
+            f"cfl_rule: damping gives an acoustic C of {c:.3g} (nu / (c0 h) = "
+            f"{scene.acoustic_damping_ratio:.3g}, density_diffusion = {scene.physics.density_diffusion}): "
+            "the laminar term and the density diffusion barely damp the acoustic modes. Use "
+            "physics.density_update: leapfrog, or cfl_rule: fixed with a C you have checked")
+
+
 def validate(scene: Scene) -> None:
     """Check physical and geometric consistency; raise SceneError naming the key."""
     _positive(scene.dp, "dp")
@@ -500,6 +542,7 @@ def validate(scene: Scene) -> None:
             f"physics.density_update: {ph.density_update!r} is not one of {', '.join(DENSITY_UPDATES)}")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
+    _validate_cfl_rule(scene)
     if ph.artificial_viscosity is not None and not 0 <= ph.artificial_viscosity <= 1:
         raise SceneError("physics.artificial_viscosity: must lie in [0, 1] (DualSPHysics' default "
                          f"is 0.01) or be null, got {ph.artificial_viscosity}")

@@ -85,6 +85,7 @@ class Simulation:
                                               self.variable_viscosity, self.strain_correction)
         self.mdbc = s.physics.boundary == "mdbc"
         self.leapfrog = s.physics.density_update == "leapfrog"  # the density at v^{n+1}: step()
+        self.cfl_acoustic = s.cfl_acoustic  # C of the acoustic limit (cfl_rule)
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
                                  self.variable_viscosity, self.implicit, self.strain_correction,
                                  self.volume_relaxation > 0)
@@ -291,7 +292,8 @@ class Simulation:
     def _update_dt(self):
         dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0,
                                          self.nu_max_now, self.scene.cfl_viscous,
-                                         viscous_limit=not self.implicit)
+                                         viscous_limit=not self.implicit,
+                                         cfl_acoustic=self.cfl_acoustic)
         self.info = StepInfo(dt, k, lim)
 
     def _shift(self, dt: float):
