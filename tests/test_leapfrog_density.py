@@ -49,7 +49,7 @@ def test_continuity_pass_is_the_pair_loops_continuity_rate(ch):
 def test_leapfrog_holds_the_coarse_conveyor_at_cfl_06():
     """dp = 2.25 mm, Ch = 2.2, the default campaign's scheme at C_CFL 0.6, where nu / (c0 h) is
     0.19: with the explicit density update the density noise grows to the guard (1.46 s here,
-    1.76 s from the campaign's film start, docs/numerics.md); with the leapfrog the fluid's largest |rho / rho0 - 1| stays at the
-    1.4-1.5 % of a stable run through 2.5 s."""
+    1.76 s from the campaign's film start, docs/numerics.md); with the leapfrog the fluid's
+    largest |rho / rho0 - 1| stays at the 1.4-1.5 % of a stable run through 2.5 s."""
     case = coarse_conveyor_case(density_update="leapfrog", cfl=0.6)
     assert worst_density_deviation(Simulation(build_scene(case)), 2.5) < 0.025
