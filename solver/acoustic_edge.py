@@ -82,6 +82,7 @@ def held(c: float, ch: float, r: float, delta: float, explicit_viscosity: bool =
     return bool(spectral_radius(m).max() <= 1.0 + 1e-12)
 
 
+@lru_cache(maxsize=256)
 def edge(ch: float, r: float, delta: float, explicit_viscosity: bool = False) -> float:
     """C*(Ch, r, delta): the first C from 0 upwards at which a lattice mode grows (steps of
     C_STEP, then bisection to 1e-4); ``C_SEARCH_MAX`` where none grows below it; 0 where even

@@ -96,7 +96,7 @@ class ConveyorCase(YamlData):
     coefsound: float = 10.0
     cfl: float = 0.2
     cfl_viscous: float | None = None  # C of the viscous limit alone; null: cfl
-    cfl_rule: str = "fixed"  # damping: the acoustic C at most 0.9 times its damped edge (Scene.cfl_acoustic)
+    cfl_rule: str = "fixed"  # damping: the acoustic C at most 0.85 times its damped edge (Scene.cfl_acoustic)
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False

@@ -276,14 +276,14 @@ class Scene(YamlData):
     def cfl_acoustic(self) -> float:
         """C of the acoustic limit dt2: ``cfl``, or with ``cfl_rule: damping`` and the explicit
         density update min(cfl, 0.85 C*(Ch, nu / (c0 h), delta)) (``acoustic_edge.damped_cfl``; the
-        laminar term's damping in its explicit form where ``viscous_update`` is explicit, else as
-        the sub-stepped update damps it). The leapfrog update keeps ``cfl``: its acoustic pair is
+        laminar term's damping in its explicit form where it stays explicit, else as the
+        sub-stepped update damps it). The leapfrog update keeps ``cfl``: its acoustic pair is
         neutral (docs/numerics.md)."""
         if self.cfl_rule == "fixed" or self.physics.density_update == "leapfrog":
             return self.cfl
         from .acoustic_edge import damped_cfl
         return damped_cfl(self.cfl, self.ch, self.acoustic_damping_ratio, self.physics.density_diffusion,
-                          explicit_viscosity=self.physics.viscous_update == "explicit")
+                          explicit_viscosity=self.viscous_update_used == "explicit")
 
     @property
     def implicit_viscosity(self) -> bool:
