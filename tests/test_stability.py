@@ -6,10 +6,11 @@ import yaml
 from study import stability
 
 
-def run(status="completed", reason="", dev=0.02, pen=0.0, drift=0.01, ke=1e-3, cfl=0.2, dp=0.004):
+def run(status="completed", reason="", dev=0.02, pen=0.0, drift=0.01, ke=1e-3, cfl=0.2, dp=0.004, **case_keys):
     t = np.linspace(0.0, 1.0, 11)
     case = {"cfl": cfl, "ch": 1.5, "shifting": "skillen", "max_area_drift": 0.05,
-            "coefsound": 10.0, "density_diffusion": 0.1, "boundary": "mdbc", "shifting_coefficient": None}
+            "coefsound": 10.0, "density_diffusion": 0.1, "boundary": "mdbc", "shifting_coefficient": None,
+            **case_keys}
     return xr.Dataset(
         {"max_density_deviation": ("diag_time", np.linspace(0.0, dev, 11)),
          "max_penetration": ("diag_time", np.linspace(0.0, pen, 11)),
@@ -47,16 +48,20 @@ def test_margins_are_fractions_of_the_guards():
     assert not stability.is_safe("completed", stability.margins(run(drift=0.03)))  # 0.6 of its guard
 
 
-def test_settings_summary_and_recommendation():
-    runs = [run(cfl=0.2), run(cfl=0.4, dev=0.15), run("diverged", "t = 0.1 s: density deviation x", cfl=0.8, dev=0.21)]
+def summary_dataset(runs) -> xr.Dataset:
     marg = [stability.margins(r) for r in runs]
-    ds = xr.Dataset({
+    return xr.Dataset({
         "case_status": ("case", [r.attrs["status"] for r in runs]),
         "case_detector": ("case", [stability.detector(r.attrs["status"], r.attrs["reason"]) for r in runs]),
         "case_safe": ("case", [int(stability.is_safe(r.attrs["status"], m)) for r, m in zip(runs, marg)]),
         "case_settings": ("case", [yaml.safe_dump(stability.case_settings(r)) for r in runs]),
         **{f"case_{k}": ("case", [m[k] for m in marg]) for k in stability.MARGINS}},
-        coords={"case": ["a", "b", "c"]})
+        coords={"case": [f"c{i}" for i in range(len(runs))]})
+
+
+def test_settings_summary_and_recommendation():
+    runs = [run(cfl=0.2), run(cfl=0.4, dev=0.15), run("diverged", "t = 0.1 s: density deviation x", cfl=0.8, dev=0.21)]
+    ds = summary_dataset(runs)
     rows = stability.settings_summary(ds)
     assert [(r["setting"], r["value"], r["survived"], r["safe"]) for r in rows] == [
         ("cfl", "0.2", 1, 1), ("cfl", "0.4", 1, 0), ("cfl", "0.8", 0, 0)]
@@ -64,7 +69,20 @@ def test_settings_summary_and_recommendation():
     assert rows[1]["alone"] == ("completed", pytest.approx(0.75))  # density 0.15 / 0.2
     rec = stability.recommended(ds)
     assert rec["settings"] == {"cfl": {"survived": ["0.2", "0.4"], "diverged": ["0.8"], "best": "0.2"}}
-    assert rec["safest_case"] == "a" and rec["base"]["cfl"] == "0.2"
+    assert rec["safest_case"] == "c0" and rec["base"]["cfl"] == "0.2"
+
+
+def test_no_recommendation_from_a_value_never_tried_alone():
+    """cfl_rule: damping is tried only with cfl 0.8, so no case varies it alone: the summary lists
+    it, the recommendation has nothing to compare it with and names no cfl_rule."""
+    runs = [run(cfl=0.2), run(cfl=0.2), run("diverged", "t = 0.1 s: density deviation x", cfl=0.8, dev=0.21),
+            run(cfl=0.8, cfl_rule="damping")]
+    ds = summary_dataset(runs)
+    rows = {(r["setting"], r["value"]): r for r in stability.settings_summary(ds)}
+    assert rows[("cfl_rule", "damping")]["survived"] == 1 and rows[("cfl_rule", "damping")]["alone"] is None
+    rec = stability.recommended(ds)
+    assert "cfl_rule" not in rec["settings"]
+    assert rec["settings"]["cfl"] == {"survived": ["0.2"], "diverged": ["0.8"], "best": "0.2"}
 
 
 def test_the_guard_that_fired_has_margin_at_least_one():

@@ -30,8 +30,8 @@ GUARD_DEFAULTS = {"max_density_deviation": 0.1, "penetration": 0.5}
 MARGINS = ("density_margin", "penetration_margin", "area_drift_margin")
 TIE = 0.02  # worst margins closer than this are not told apart
 SAFE_FRACTION = 0.5  # a survivor is "safe" when every margin stays below this fraction
-SETTINGS = ("dp", "ch", "shifting", "shifting_coefficient", "cfl", "coefsound", "density_diffusion",
-            "boundary")
+SETTINGS = ("dp", "ch", "shifting", "shifting_coefficient", "cfl", "cfl_rule", "coefsound",
+            "density_diffusion", "boundary")
 
 
 def detector(status: str, reason: str) -> str:
@@ -139,7 +139,8 @@ def settings_summary(ds: xr.Dataset) -> list[dict]:
 
 def recommended(ds: xr.Dataset) -> dict:
     """One setting at a time, all others at the base: the values that survived, and among them
-    the one with the largest margin; plus the case with the largest margin among the safe ones."""
+    the one with the largest margin (for a setting with at least two values tried alone); plus the
+    case with the largest margin among the safe ones."""
     base = {k: _fmt(v) for k, v in base_settings([yaml.safe_load(s) for s in ds["case_settings"].values]).items()}
     out = {}
     for r in settings_summary(ds):
@@ -152,6 +153,8 @@ def recommended(ds: xr.Dataset) -> dict:
         is_base = r["value"] == base[r["setting"]]
         if st != "diverged" and np.isfinite(w) and (w < entry["_w"] - TIE or (is_base and w <= entry["_w"] + TIE)):
             entry["best"], entry["_w"] = r["value"], w
+    for key in [k for k, e in out.items() if len(e["survived"]) + len(e["diverged"]) < 2]:
+        del out[key]  # one value tried alone: nothing to recommend it over
     for entry in out.values():
         entry.pop("_w")
     safe = ds["case_safe"].values.astype(bool)
