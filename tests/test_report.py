@@ -41,6 +41,19 @@ def test_the_case_table_gives_the_metrics_with_their_sampling_error():
     assert table.count("0.0159 &plusmn; 0.00058") == ds.sizes["case"] * ds.sizes["station"]
 
 
+def test_the_case_table_gives_the_acoustic_cfl_each_run_used():
+    """cfl_rule: damping may lower a case's C_CFL: the table shows what each run took, and a dash
+    for a run written before the runs recorded it."""
+    from study.report import case_table
+    ds = campaign(paper_like)
+    dashes = case_table(ds).count("<td>&ndash;</td>")  # no case_cfl_acoustic in the dataset
+    ds["case_cfl_acoustic"] = ("case", [0.4] * (ds.sizes["case"] - 1) + [0.468])
+    table = case_table(ds)
+    assert dashes - table.count("<td>&ndash;</td>") == ds.sizes["case"]
+    assert "C_CFL used" in table and table.count("<td>0.4</td>") == ds.sizes["case"] - 1
+    assert table.count("<td>0.468</td>") == 1
+
+
 def test_a_yield_stress_campaign_is_not_judged_against_the_newtonian_paper():
     """The paper's conclusions concern a Newtonian fluid: a Herschel-Bulkley campaign's report
     says so instead of giving verdicts on them."""

@@ -19,6 +19,7 @@ RUN_NUMBERS = {
     "simulated_time": ("simulated_time_s", "s", "simulated time"),
     "steady_state_time": ("steady_state_time_s", "s", "time steady state was detected"),
     "threads": ("threads", "1", "threads"),
+    "cfl_acoustic": ("cfl_acoustic", "1", "C_CFL of the acoustic limit the run used (cfl_rule)"),
 }
 FRONT_XSTAR = 3.0  # particles within this x* of the toe are kept for the front figure
 

@@ -59,7 +59,7 @@ def _with_error(value, se) -> str:
 
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
-    head = ["case", "status", "steady", "wall time [s]", "steps", "particles", "steady at [s]",
+    head = ["case", "status", "steady", "wall time [s]", "steps", "C_CFL used", "particles", "steady at [s]",
             "zeta_f (± 2 se)", "zeta_h (h_n, ± 2 se)", "zeta_h (paper, ± 2 se)", "zeta_fs (± 2 se)"] + [
                 f"zeta_u x*={s:g} (± 2 se)" for s in st]
     rows = []
@@ -70,8 +70,8 @@ def case_table(ds: xr.Dataset) -> str:
                  f'<td class="l" title="{html.escape(reason)}">{html.escape(status)}'
                  + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>",
                  f'<td>{"yes" if int(ds["case_steady"].values[i]) else "no"}</td>']
-        for k in ("case_wall_time", "case_steps", "case_n_particles", "case_steady_state_time"):
-            cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
+        for k in ("case_wall_time", "case_steps", "case_cfl_acoustic", "case_n_particles", "case_steady_state_time"):
+            cells.append(f"<td>{_fmt(ds[k].values[i] if k in ds else np.nan)}</td>")  # older datasets lack C
         for k in ("case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
             se = ds[f"{k}_se"].values[i] if f"{k}_se" in ds else None
             cells.append(f"<td>{_with_error(ds[k].values[i], se)}</td>")
