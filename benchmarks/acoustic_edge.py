@@ -76,7 +76,7 @@ def main(argv=None):
     for name, sets in runs:
         sc = scene_of(args.case, sets)
         r, delta = sc.acoustic_damping_ratio, sc.physics.density_diffusion or 0.0
-        c_star = acoustic_edge.edge(sc.ch, r, delta, sc.physics.viscous_update == "explicit")
+        c_star = acoustic_edge.edge(sc.ch, r, delta)
         rows.append((name, sc, r, delta, c_star))
     outcomes = [""] * len(runs)
     if not args.predict:

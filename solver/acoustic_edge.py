@@ -11,8 +11,10 @@ x_ba = x_b - x_a, gradW_ab = F(r) x_ab and the sums over the lattice points b wi
 Under the explicit density update (``Simulation.step``) the mode's amplification on
 (rho, v, dt D^{n-1}) is, with a = omega dt, b = g dt, e = d dt:
 - rho_h = rho^n + dt/2 D^{n-1}; D = -omega v^n - d rho_h (the previous step's rate drifts it);
-- v^{n+1} = exp(-b) v^n + a rho_h (the laminar term sub-stepped or implicit), or
-  (1 - b) v^n + a rho_h (explicit); rho^{n+1} = rho^n + dt D.
+- v^{n+1} = exp(-b) v^n + a rho_h, rho^{n+1} = rho^n + dt D. exp(-b) is the laminar term
+  sub-stepped or implicit. An explicit one damps as (1 - b), at least as much for b up to 1.28;
+  its own stability at larger b is the viscous limit's (dt3), so the edge takes exp(-b) for
+  every update (``amplification`` has both forms).
 With dt = C h / c0 and r = nu / (c0 h): a = C h|G|, b = C r h^2 L, e = delta C h^2 L. Undamped
 (b = e = 0) every mode grows; C*(Ch, r, delta) is the first C at which some k of the lattice's
 quarter zone has spectral radius above 1. Nothing here is fitted to runs; the measured edges it
@@ -75,31 +77,31 @@ def spectral_radius(m: np.ndarray) -> np.ndarray:
     return np.abs(np.linalg.eigvals(m)).max(axis=-1)
 
 
-def held(c: float, ch: float, r: float, delta: float, explicit_viscosity: bool = False) -> bool:
-    """Whether every lattice mode is held (spectral radius <= 1) at C = ``c``."""
+def held(c: float, ch: float, r: float, delta: float) -> bool:
+    """Whether every lattice mode is held (spectral radius <= 1) at C = ``c``, the laminar term
+    damping as exp(-b)."""
     hg, h2l = lattice_symbols(ch)
-    m = amplification(c * hg, c * r * h2l, delta * c * h2l, explicit_viscosity)
+    m = amplification(c * hg, c * r * h2l, delta * c * h2l)
     return bool(spectral_radius(m).max() <= 1.0 + 1e-12)
 
 
 @lru_cache(maxsize=256)
-def edge(ch: float, r: float, delta: float, explicit_viscosity: bool = False) -> float:
+def edge(ch: float, r: float, delta: float) -> float:
     """C*(Ch, r, delta): the first C from 0 upwards at which a lattice mode grows (steps of
     C_STEP, then bisection to 1e-4); ``C_SEARCH_MAX`` where none grows below it; 0 where even
     the smallest step's C is not held."""
     c = C_STEP
-    while held(c, ch, r, delta, explicit_viscosity):
+    while held(c, ch, r, delta):
         c += C_STEP
         if c > C_SEARCH_MAX:
             return C_SEARCH_MAX
     lo, hi = c - C_STEP, c
     while hi - lo > 1e-4:
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if held(mid, ch, r, delta, explicit_viscosity) else (lo, mid)
+        lo, hi = (mid, hi) if held(mid, ch, r, delta) else (lo, mid)
     return lo
 
 
-def damped_cfl(cfl: float, ch: float, r: float, delta: float | None,
-               explicit_viscosity: bool = False) -> float:
+def damped_cfl(cfl: float, ch: float, r: float, delta: float | None) -> float:
     """The acoustic C of ``cfl_rule: damping``: min(cfl, MARGIN C*(Ch, r, delta))."""
-    return min(cfl, MARGIN * edge(ch, r, delta or 0.0, explicit_viscosity))
+    return min(cfl, MARGIN * edge(ch, r, delta or 0.0))

@@ -275,15 +275,12 @@ class Scene(YamlData):
     @property
     def cfl_acoustic(self) -> float:
         """C of the acoustic limit dt2: ``cfl``, or with ``cfl_rule: damping`` and the explicit
-        density update min(cfl, 0.85 C*(Ch, nu / (c0 h), delta)) (``acoustic_edge.damped_cfl``; the
-        laminar term's damping in its explicit form where it stays explicit, else as the
-        sub-stepped update damps it). The leapfrog update keeps ``cfl``: its acoustic pair is
-        neutral (docs/numerics.md)."""
+        density update min(cfl, 0.85 C*(Ch, nu / (c0 h), delta)) (``acoustic_edge.damped_cfl``).
+        The leapfrog update keeps ``cfl``: its acoustic pair is neutral (docs/numerics.md)."""
         if self.cfl_rule == "fixed" or self.physics.density_update == "leapfrog":
             return self.cfl
         from .acoustic_edge import damped_cfl
-        return damped_cfl(self.cfl, self.ch, self.acoustic_damping_ratio, self.physics.density_diffusion,
-                          explicit_viscosity=self.viscous_update_used == "explicit")
+        return damped_cfl(self.cfl, self.ch, self.acoustic_damping_ratio, self.physics.density_diffusion)
 
     @property
     def implicit_viscosity(self) -> bool:

@@ -127,6 +127,14 @@ def test_rule_does_not_bind_on_the_shipped_grids(config):
         assert bound > d["cfl"], case.id
 
 
+def test_rule_leaves_a_very_viscous_scene_its_cfl():
+    """The Couette example (nu / (c0 h) = 26.7, explicit laminar term): the laminar term damps the
+    acoustic modes strongly, and its own stability is the viscous limit's, so C stays cfl."""
+    scene = example_scene("couette", cfl_rule="damping")
+    assert scene.viscous_update_used == "explicit" and scene.acoustic_damping_ratio > 10
+    assert scene.cfl_acoustic == scene.cfl
+
+
 def test_rule_refuses_what_it_cannot_bound():
     with pytest.raises(SceneError, match="case.cfl_rule: 'auto' is not one of fixed, damping"):
         coarse_conveyor_case(cfl_rule="auto")
@@ -135,6 +143,8 @@ def test_rule_refuses_what_it_cannot_bound():
     with pytest.raises(SceneError, match="density_update: leapfrog"):  # no damping at all
         example_scene("couette", cfl_rule="damping", physics={"density_diffusion": None},
                       fluid={"viscosity": 1e-9})
+    with pytest.raises(SceneError, match="needs one viscosity"):
+        example_scene("hb_film", cfl_rule="damping")
 
 
 @pytest.mark.slow
