@@ -7,10 +7,11 @@ the line sets it, ``steady.stop=false`` and
 ``steady.max_time=TO``, on one thread, JOBS at a time (``python -m solver front``), and the table
 gives nu / (c0 h), the acoustic C the run used, the model's edge C* (Ch, nu / (c0 h), delta), their
 ratio, and whether the run held to TO or where a guard stopped it. ``--predict`` prints the model
-alone, without running.
+alone, without running; ``--leapfrog`` adds the edge of the leapfrog density update
+(``acoustic_edge.leapfrog_amplification``) under the same symbols.
 
 Usage: python benchmarks/acoustic_edge.py [--runs FILE] [--case CASE] [--to 6] [--jobs 2]
-       [--out DIR] [--predict]
+       [--out DIR] [--predict] [--leapfrog]
 """
 from __future__ import annotations
 
@@ -70,6 +71,8 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=ROOT / "results" / "acoustic_edge")
     ap.add_argument("--predict", action="store_true", help="the model only, no runs")
+    ap.add_argument("--leapfrog", action="store_true",
+                    help="add the leapfrog update's edge (density_update: leapfrog) as a column")
     args = ap.parse_args(argv)
     runs = read_runs(args.runs)
     rows = []
@@ -83,12 +86,15 @@ def main(argv=None):
         args.out.mkdir(parents=True, exist_ok=True)
         with ThreadPoolExecutor(args.jobs) as pool:
             outcomes = list(pool.map(lambda nr: run_one(args.case, args.out, nr[0], nr[1], args.to), runs))
-    print("| run | dp [mm] | Ch | delta | nu / (c0 h) | C used | C* | C / C* | outcome |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    lf_head = " leapfrog's C* |" if args.leapfrog else ""
+    print(f"| run | dp [mm] | Ch | delta | nu / (c0 h) | C used | C* | C / C* |{lf_head} outcome |")
+    print("|---|---|---|---|---|---|---|---|" + ("---|" if args.leapfrog else "") + "---|")
     for (name, sc, r, delta, c_star), outcome in zip(rows, outcomes):
         c = sc.cfl_acoustic
+        lf = (f" {acoustic_edge.edge(sc.ch, r, delta, acoustic_edge.leapfrog_amplification):.3f} |"
+              if args.leapfrog else "")
         print(f"| {name} | {sc.dp * 1e3:g} | {sc.ch:g} | {delta:g} | {r:.3f} | {c:.3f} | {c_star:.3f} | "
-              f"{c / c_star:.2f} | {outcome} |")
+              f"{c / c_star:.2f} |{lf} {outcome} |")
 
 
 if __name__ == "__main__":

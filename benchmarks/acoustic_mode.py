@@ -22,11 +22,9 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from solver.acoustic_edge import amplification, spectral_radius  # noqa: E402
+from solver.acoustic_edge import amplification, leapfrog_amplification, spectral_radius  # noqa: E402
 
 
 def radius(a: float, b: float = 0.0, e: float = 0.0, explicit_viscosity: bool = False) -> float:
@@ -36,11 +34,8 @@ def radius(a: float, b: float = 0.0, e: float = 0.0, explicit_viscosity: bool = 
 
 def leapfrog_radius(a: float) -> float:
     """Undamped, the leapfrog: rho_h = rho^n + dt/2 D(v^n), v^{n+1} = v^n + dt omega rho_h,
-    rho^{n+1} = rho_h + dt/2 D(v^{n+1}); on (rho, v, dt D^{n-1}) as the solver's."""
-    m = np.array([[1.0 - 0.5 * a * a, -0.5 * a, 0.5 - 0.25 * a * a],  # rho_h - a/2 v^{n+1}
-                  [a, 1.0, 0.5 * a],  # v^n + a rho_h
-                  [-a * a, -a, -0.5 * a * a]])  # dt D(v^{n+1})
-    return float(spectral_radius(m))
+    rho^{n+1} = rho_h + dt/2 D(v^{n+1})."""
+    return float(spectral_radius(leapfrog_amplification(a, 0.0, 0.0)))
 
 
 def least_damping(a: float, which: str, explicit_viscosity: bool = False) -> float:

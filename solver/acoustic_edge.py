@@ -73,32 +73,45 @@ def amplification(a, b, e, explicit_viscosity: bool = False) -> np.ndarray:
     return m
 
 
+def leapfrog_amplification(a, b, e) -> np.ndarray:
+    """The leapfrog density update's step matrices (``density_update: leapfrog``) on the same
+    (rho, v, q = dt D^{n-1}): rho_h = rho^n + q / 2, v^{n+1} = exp(-b) v^n + a rho_h, the rate at
+    v^{n+1} q' = -a v^{n+1} - e rho_h, rho^{n+1} = rho_h + q' / 2."""
+    a, b, e = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, e)))
+    damp = np.exp(-b)
+    m = np.empty(a.shape + (3, 3))
+    m[..., 0, :] = np.stack([1.0 - 0.5 * (a * a + e), -0.5 * a * damp, 0.5 - 0.25 * (a * a + e)], axis=-1)
+    m[..., 1, :] = np.stack([a, damp, 0.5 * a], axis=-1)
+    m[..., 2, :] = np.stack([-(a * a + e), -a * damp, -0.5 * (a * a + e)], axis=-1)
+    return m
+
+
 def spectral_radius(m: np.ndarray) -> np.ndarray:
     return np.abs(np.linalg.eigvals(m)).max(axis=-1)
 
 
-def held(c: float, ch: float, r: float, delta: float) -> bool:
-    """Whether every lattice mode is held (spectral radius <= 1) at C = ``c``, the laminar term
-    damping as exp(-b)."""
+def held(c: float, ch: float, r: float, delta: float, step=amplification) -> bool:
+    """Whether every lattice mode is held (spectral radius <= 1) at C = ``c`` under ``step``
+    (the explicit density update by default), the laminar term damping as exp(-b)."""
     hg, h2l = lattice_symbols(ch)
-    m = amplification(c * hg, c * r * h2l, delta * c * h2l)
+    m = step(c * hg, c * r * h2l, delta * c * h2l)
     return bool(spectral_radius(m).max() <= 1.0 + 1e-12)
 
 
 @lru_cache(maxsize=256)
-def edge(ch: float, r: float, delta: float) -> float:
-    """C*(Ch, r, delta): the first C from 0 upwards at which a lattice mode grows (steps of
-    C_STEP, then bisection to 1e-4); ``C_SEARCH_MAX`` where none grows below it; 0 where even
-    the smallest step's C is not held."""
+def edge(ch: float, r: float, delta: float, step=amplification) -> float:
+    """C*(Ch, r, delta): the first C from 0 upwards at which a lattice mode grows under ``step``
+    (steps of C_STEP, then bisection to 1e-4); ``C_SEARCH_MAX`` where none grows below it; 0
+    where even the smallest step's C is not held."""
     c = C_STEP
-    while held(c, ch, r, delta):
+    while held(c, ch, r, delta, step):
         c += C_STEP
         if c > C_SEARCH_MAX:
             return C_SEARCH_MAX
     lo, hi = c - C_STEP, c
     while hi - lo > 1e-4:
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if held(mid, ch, r, delta) else (lo, mid)
+        lo, hi = (mid, hi) if held(mid, ch, r, delta, step) else (lo, mid)
     return lo
 
 

@@ -90,6 +90,19 @@ def test_edge_is_where_the_amplification_crosses_one():
     assert acoustic_edge.spectral_radius(m) == pytest.approx(1.1306, abs=1e-4)
 
 
+def test_the_leapfrog_is_neutral_up_to_a_2_and_damping_lowers_its_edge():
+    """Undamped, the leapfrog's radius is 1 up to a = omega dt = 2 and above 1 beyond; on the
+    lattice its undamped edge is 2 / max h|G|, and the fast example's damping lowers it."""
+    for a in (0.3, 1.0, 1.9):
+        assert acoustic_edge.spectral_radius(acoustic_edge.leapfrog_amplification(a, 0.0, 0.0)) == \
+            pytest.approx(1.0, abs=1e-9)
+    assert acoustic_edge.spectral_radius(acoustic_edge.leapfrog_amplification(2.1, 0.0, 0.0)) > 1.5
+    undamped = acoustic_edge.edge(1.8, 0.0, 0.0, acoustic_edge.leapfrog_amplification)
+    assert undamped == pytest.approx(2.0 / acoustic_edge.lattice_symbols(1.8)[0].max(), abs=1e-3)
+    damped = acoustic_edge.edge(1.8, 0.524, 0.1, acoustic_edge.leapfrog_amplification)
+    assert acoustic_edge.edge(1.8, 0.524, 0.1) < damped < undamped
+
+
 def test_rule_leaves_the_paper_case_and_lowers_the_coarse_one():
     """At dp = 1 mm, Ch = 1.8 (nu / (c0 h) = 0.52) the rule keeps C = 0.6 exactly, so the shipped
     runs are unchanged; at dp = 2.25 mm, Ch = 2.2 (0.19) it gives 0.85 C*; ``fixed`` and the
