@@ -101,8 +101,8 @@ def held(c: float, ch: float, r: float, delta: float, step=amplification) -> boo
 @lru_cache(maxsize=256)
 def edge(ch: float, r: float, delta: float, step=amplification) -> float:
     """C*(Ch, r, delta): the first C from 0 upwards at which a lattice mode grows under ``step``
-    (steps of C_STEP, then bisection to 1e-4); ``C_SEARCH_MAX`` where none grows below it; 0
-    where even the smallest step's C is not held."""
+    (steps of C_STEP, then bisection to 1e-4); ``C_SEARCH_MAX`` where none grows below it; below
+    C_STEP where C_STEP itself is not held (0 without any damping)."""
     c = C_STEP
     while held(c, ch, r, delta, step):
         c += C_STEP

@@ -158,6 +158,8 @@ def test_rule_refuses_what_it_cannot_bound():
                       fluid={"viscosity": 1e-9})
     with pytest.raises(SceneError, match="needs one viscosity"):
         example_scene("hb_film", cfl_rule="damping")
+    # a small cfl of the user's own is not the rule's doing: kept, not refused
+    assert example_scene("couette", cfl_rule="damping", cfl=0.01).cfl_acoustic == 0.01
 
 
 @pytest.mark.slow
