@@ -7,8 +7,8 @@ of the two largest deviations and the heights at which the fluid's sits. With
 ``--stage-margin M`` (M < 1) the sub-stepped laminar term takes the fewest RKC stages s with
 z <= M beta_s instead of z <= beta_s (``solver.implicit.rkc_stages``), for this run only.
 
-    python benchmarks/density_noise.py CASE.yaml --set cfl=0.6 --set steady.stop=false \\
-        --set steady.max_time=2 [--stage-margin 0.5] [-o OUT.npz]
+    python benchmarks/density_noise.py CASE.yaml --set cfl=0.6 --set cfl_rule=fixed \\
+        --set steady.stop=false --set steady.max_time=2 [--stage-margin 0.5] [-o OUT.npz]
 """
 from __future__ import annotations
 

@@ -13,8 +13,8 @@ where the solver's option gets D_new from a continuity pass over the velocity ch
 --shipped it runs the solver's step as the case sets it. Prints the run's line and the median
 of the run's largest fluid density deviation from --from s on.
 
-    python benchmarks/leapfrog_density.py CASE.yaml --set cfl=0.6 --set steady.stop=false \\
-        --set steady.max_time=4 [--shipped] [-o OUT.nc]
+    python benchmarks/leapfrog_density.py CASE.yaml --set cfl=0.6 --set cfl_rule=fixed \\
+        --set steady.stop=false --set steady.max_time=4 [--shipped] [-o OUT.nc]
 """
 from __future__ import annotations
 

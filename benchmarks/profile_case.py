@@ -93,13 +93,15 @@ def main(argv=None):
 
 
 def case_scheme(case) -> dict:
-    """The scene keys of a conveyor case's scheme, for the throughput layer: its physics, its
-    C_CFL and its sound speed c0 (so that the layer's step and RKC stage count match)."""
+    """The scene keys of a conveyor case's scheme, for the throughput layer: its physics, the
+    acoustic C_CFL it runs at (after ``cfl_rule``) and its sound speed c0 (so that the layer's
+    step and RKC stage count match)."""
     from solver.conveyor import build_scene_dict
     from solver.scene import scene_from_dict
     d = build_scene_dict(case)
-    return {"physics": d["physics"], "cfl": d["cfl"], "cfl_viscous": d["cfl_viscous"],
-            "sound": {"c0": scene_from_dict(d).c0}}
+    scene = scene_from_dict(d)
+    return {"physics": d["physics"], "cfl": scene.cfl_acoustic, "cfl_viscous": d["cfl_viscous"],
+            "sound": {"c0": scene.c0}}
 
 
 if __name__ == "__main__":
