@@ -27,6 +27,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from .kernel import grad_coefficient
+
 MARGIN = 0.85  # the rule's C is at most this fraction of C*
 N_K = 16  # wavenumbers per axis of the quarter zone (0, pi / dp]
 C_STEP = 0.01  # the edge's search steps in C, then bisection
@@ -43,8 +45,7 @@ def symbols(ch: float, kx, kz) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r = np.hypot(x, z)
     inside = (r > 0) & (r < 2.0 * h)
     x, z, r = x[inside], z[inside], r[inside]
-    alpha = 7.0 / (4.0 * math.pi * h * h)  # solver/kernel.py's quintic Wendland
-    F = -5.0 * alpha / (h * h) * (1.0 - 0.5 * r / h) ** 3
+    F = grad_coefficient(h) * (1.0 - 0.5 * r / h) ** 3  # gradW_ab = F x_ab (solver/kernel.py)
     lap_weight = -2.0 * F * r * r / (r * r + 0.01 * h * h)
     phase = np.ravel(kx)[:, None] * x + np.ravel(kz)[:, None] * z
     s = np.sin(phase)
@@ -61,29 +62,34 @@ def lattice_symbols(ch: float, n_k: int = N_K) -> tuple[np.ndarray, np.ndarray]:
     return np.hypot(hgx, hgz), h2l
 
 
+def _matrices(a, b, e, rows) -> np.ndarray:
+    """3x3 step matrices, one per entry of the broadcast arrays a, b, e; ``rows(a, b, e)`` gives
+    the three rows, each a list of three arrays."""
+    a, b, e = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, e)))
+    return np.stack([np.stack(row, axis=-1) for row in rows(a, b, e)], axis=-2)
+
+
 def amplification(a, b, e, explicit_viscosity: bool = False) -> np.ndarray:
     """The explicit density update's step matrices on (rho, v, dt D^{n-1}), one per entry of the
     arrays a = omega dt, b = g dt, e = d dt."""
-    a, b, e = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, e)))
-    damp = (1.0 - b) if explicit_viscosity else np.exp(-b)
-    m = np.empty(a.shape + (3, 3))
-    m[..., 0, :] = np.stack([1.0 - e, -a, -0.5 * e], axis=-1)  # rho^n + dt D
-    m[..., 1, :] = np.stack([a, damp, 0.5 * a], axis=-1)  # damp v^n + a rho_h
-    m[..., 2, :] = np.stack([-e, -a, -0.5 * e], axis=-1)  # dt D
-    return m
+    def rows(a, b, e):
+        damp = (1.0 - b) if explicit_viscosity else np.exp(-b)
+        return ([1.0 - e, -a, -0.5 * e],  # rho^n + dt D
+                [a, damp, 0.5 * a],  # damp v^n + a rho_h
+                [-e, -a, -0.5 * e])  # dt D
+    return _matrices(a, b, e, rows)
 
 
 def leapfrog_amplification(a, b, e) -> np.ndarray:
     """The leapfrog density update's step matrices (``density_update: leapfrog``) on the same
     (rho, v, q = dt D^{n-1}): rho_h = rho^n + q / 2, v^{n+1} = exp(-b) v^n + a rho_h, the rate at
     v^{n+1} q' = -a v^{n+1} - e rho_h, rho^{n+1} = rho_h + q' / 2."""
-    a, b, e = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, e)))
-    damp = np.exp(-b)
-    m = np.empty(a.shape + (3, 3))
-    m[..., 0, :] = np.stack([1.0 - 0.5 * (a * a + e), -0.5 * a * damp, 0.5 - 0.25 * (a * a + e)], axis=-1)
-    m[..., 1, :] = np.stack([a, damp, 0.5 * a], axis=-1)
-    m[..., 2, :] = np.stack([-(a * a + e), -a * damp, -0.5 * (a * a + e)], axis=-1)
-    return m
+    def rows(a, b, e):
+        damp, s = np.exp(-b), a * a + e
+        return ([1.0 - 0.5 * s, -0.5 * a * damp, 0.5 - 0.25 * s],
+                [a, damp, 0.5 * a],
+                [-s, -a * damp, -0.5 * s])
+    return _matrices(a, b, e, rows)
 
 
 def spectral_radius(m: np.ndarray) -> np.ndarray:

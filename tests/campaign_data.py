@@ -62,6 +62,7 @@ def campaign(metric, steady=lambda dp, ch, sh: True, status=lambda dp, ch, sh: "
     ds["case_steady"] = ("case", [int(st[ix]) for ix in flat])
     ds["case_wall_time"] = ("case", [wall[ix] for ix in flat])
     ds["case_steps"] = ("case", [1000.0 for _ in flat])
+    ds["case_cfl_acoustic"] = ("case", [np.nan for _ in flat])  # as from runs that did not record it
     ds["case_n_particles"] = ("case", [1000.0 for _ in flat])
     ds["case_steady_state_time"] = ("case", [3.0 for _ in flat])
     for k, v in scal.items():

@@ -46,7 +46,7 @@ def test_the_case_table_gives_the_acoustic_cfl_each_run_used():
     for a run written before the runs recorded it."""
     from study.report import case_table
     ds = campaign(paper_like)
-    dashes = case_table(ds).count("<td>&ndash;</td>")  # no case_cfl_acoustic in the dataset
+    dashes = case_table(ds).count("<td>&ndash;</td>")  # case_cfl_acoustic NaN: not recorded
     ds["case_cfl_acoustic"] = ("case", [0.4] * (ds.sizes["case"] - 1) + [0.468])
     table = case_table(ds)
     assert dashes - table.count("<td>&ndash;</td>") == ds.sizes["case"]

@@ -71,7 +71,7 @@ def case_table(ds: xr.Dataset) -> str:
                  + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>",
                  f'<td>{"yes" if int(ds["case_steady"].values[i]) else "no"}</td>']
         for k in ("case_wall_time", "case_steps", "case_cfl_acoustic", "case_n_particles", "case_steady_state_time"):
-            cells.append(f"<td>{_fmt(ds[k].values[i] if k in ds else np.nan)}</td>")  # older datasets lack C
+            cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
         for k in ("case_zeta_f", "case_zeta_h", "case_zeta_h_paper", "case_zeta_fs"):
             se = ds[f"{k}_se"].values[i] if f"{k}_se" in ds else None
             cells.append(f"<td>{_with_error(ds[k].values[i], se)}</td>")
