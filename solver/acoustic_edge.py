@@ -27,7 +27,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .kernel import grad_coefficient
+from .kernel import ETA2, grad_coefficient
 
 MARGIN = 0.85  # the rule's C is at most this fraction of C*
 N_K = 16  # wavenumbers per axis of the quarter zone (0, pi / dp]
@@ -46,7 +46,7 @@ def symbols(ch: float, kx, kz) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     inside = (r > 0) & (r < 2.0 * h)
     x, z, r = x[inside], z[inside], r[inside]
     F = grad_coefficient(h) * (1.0 - 0.5 * r / h) ** 3  # gradW_ab = F x_ab (solver/kernel.py)
-    lap_weight = -2.0 * F * r * r / (r * r + 0.01 * h * h)
+    lap_weight = -2.0 * F * r * r / (r * r + ETA2 * h * h)
     phase = np.ravel(kx)[:, None] * x + np.ravel(kz)[:, None] * z
     s = np.sin(phase)
     return (-h * (s * (F * x)).sum(axis=1), -h * (s * (F * z)).sum(axis=1),

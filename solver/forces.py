@@ -40,7 +40,7 @@ from typing import NamedTuple
 import numba as nb
 import numpy as np
 
-from .kernel import alpha_2d, grad_coefficient, grad_factor, w_value
+from .kernel import ETA2, alpha_2d, grad_coefficient, grad_factor, w_value
 
 # Accumulator slots of the pair loop, acc[thread, particle, slot]
 AX, AZ, DRHO = 0, 1, 2                # acceleration, drho/dt
@@ -162,6 +162,13 @@ class PairConstants(NamedTuple):
 # ---- the SPEC terms of one pair (a, b), gradW_ab = F r_ab, each inlined into the loop ----
 
 @nb.njit(inline="always", cache=True)
+def two_reciprocals(x, y):
+    """(1 / x, 1 / y) from one division: 1 / (x y) times y, and times x."""
+    inv = 1.0 / (x * y)
+    return inv * y, inv * x
+
+
+@nb.njit(inline="always", cache=True)
 def continuity_terms(ra, rb, F, vdotr):
     """(rho_a, rho_b) u_ab . gradW_ab = rho F (u_ab . r_ab): a's term per V_b and b's per V_a
     (u_ba . gradW_ba is the same product)."""
@@ -277,7 +284,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         h, nu, hc0, rho0 = k.h, k.nu, k.hc0, k.rho0
         nt = split.size - 1
         fac = grad_coefficient(h)
-        eta2 = 0.01 * h * h
+        eta2 = ETA2 * h * h
         alpha = alpha_2d(h)
         four_h2 = 4.0 * h * h
         two_h = 2.0 * h
@@ -359,8 +366,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 mb = mass[b]
                                 irb = irho[b]
                                 Vb = mb * irb
-                                inv_r2e = 1.0 / (r2 + eta2)
-                                inv_rsum = 1.0 / (ra + rb)
+                                inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
                                 ca, cb = continuity_terms(ra, rb, F, vdotr)
                                 s_drho += ca * Vb
                                 drho_b = cb * Va

@@ -8,6 +8,8 @@ import math
 import numba as nb
 import numpy as np
 
+ETA2 = 0.01  # eta^2 / h^2: the regularisation r^2 + eta^2 of 1 / r^2 in the laminar and diffusion terms
+
 
 @nb.njit(inline="always", cache=True)
 def alpha_2d(h):
