@@ -377,3 +377,27 @@ def test_zeta_f_error_is_the_scatter_of_the_last_second_toe_slope():
     assert 0.8 * spread < float(np.median(errs)) < 1.2 * spread, (spread, np.median(errs))
     coarse = t[::25]  # probes every 0.5 s: 3 samples in the last second, no scatter to measure
     assert math.isnan(zeta_f_error(coarse, 0.4 + rng.normal(0.0, sigma, coarse.size), u_b))
+
+
+# ---- benchmarks/compare_campaigns.py ----------------------------------------------------
+def test_compare_campaigns_measures_changes_in_combined_standard_errors():
+    """z = (new - old) / sqrt(se_new^2 + se_old^2), per case and metric: a zeta_h moved by
+    3 se in both runs' units is z = 3 / sqrt(2), the only |z| above 2; others stay 0."""
+    import importlib.util
+    from campaign_data import campaign
+    from test_verdict import paper_like
+    spec = importlib.util.spec_from_file_location("compare_campaigns",
+                                                  ROOT / "benchmarks" / "compare_campaigns.py")
+    cc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(cc)
+    old = campaign(paper_like)
+    for m in cc.METRICS:
+        old[f"case_{m}_se"] = xr.full_like(old[f"case_{m}"], 0.001)
+    new = old.copy(deep=True)
+    moved = str(new.case.values[2])
+    new["case_zeta_h"].loc[{"case": moved}] = old["case_zeta_h"].sel(case=moved) + 0.003
+    rows = cc.changes(new, old.isel(case=slice(1, None)))  # a case only the new one ran is left out
+    assert str(new.case.values[0]) not in rows and len(rows) == new.sizes["case"] - 1
+    assert rows[moved]["z"]["zeta_h"] == pytest.approx([3.0 / math.sqrt(2.0)])
+    z = cc.largest(rows)
+    assert (z > 2).sum() == 1 and z.size == (new.sizes["case"] - 1) * (3 + new.sizes["station"])
