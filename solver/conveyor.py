@@ -103,6 +103,7 @@ class ConveyorCase(YamlData):
     volume_relaxation: float | None = None
     viscous_update: str = "explicit"  # implicit or substepped: no viscous limit on dt; auto(_substepped): where it pays
     density_update: str = "explicit"  # leapfrog: the density's second half step at v^{n+1}
+    no_tension: bool = False  # the fluid density floored at rho0 after each step (physics.no_tension)
     boundary: str = "mdbc"
     mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
@@ -358,7 +359,7 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
                     "viscous_correction": c.viscous_correction,
                     "volume_relaxation": c.volume_relaxation,
                     "viscous_update": c.viscous_update, "density_update": c.density_update,
-                    "shifting": shifting},
+                    "no_tension": c.no_tension, "shifting": shifting},
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,

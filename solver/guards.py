@@ -57,6 +57,18 @@ def check(health, guards, dp: float) -> str:
     return ""
 
 
+def worst_density(x, z, rho, kind, n: int, rho0: float) -> str:
+    """Where the fluid's largest finite |rho/rho0 - 1| lies, for a density-deviation reason:
+    ' (rho/rho0 - 1 = DEV at x = X m, z = Z m)', in the scene's frame; '' without fluid."""
+    fluid = np.flatnonzero(kind[:n] == 0)
+    dev = np.abs(rho[fluid] / rho0 - 1.0)
+    dev = np.where(np.isfinite(dev), dev, -1.0)
+    if fluid.size == 0 or dev.max() < 0:
+        return ""
+    i = fluid[int(np.argmax(dev))]
+    return f" (rho/rho0 - 1 = {rho[i] / rho0 - 1.0:+.3g} at x = {x[i]:.4g} m, z = {z[i]:.4g} m)"
+
+
 def check_dt(dt: float, dt_first: float, guards) -> str:
     if not math.isfinite(dt) or dt < guards.min_dt_fraction * dt_first:
         return (f"time step collapsed: dt = {dt:.3g} s below guards.min_dt_fraction = "

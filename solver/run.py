@@ -10,7 +10,6 @@ from typing import Protocol
 
 import numba as nb
 
-from . import guards
 from .scene import Scene
 from .simulation import Simulation
 
@@ -128,7 +127,7 @@ class Runner:
         eps = 1e-9 * tm.end
         progress = Progress(tm.end, quiet)
         if sim.steps == 0 and not res.diag_time:
-            reason = guards.check(sim.check_health(), self.scene.guards, self.scene.dp)
+            reason = sim.health_reason()
             if reason:
                 self._end("diverged", f"initial state: {reason}")
         while not self.done:

@@ -368,7 +368,7 @@ class Simulation:
         self._wrap()
         self.t = t + dt
         self.steps += 1
-        reason = guards.check(self.check_health(), s.guards, s.dp)
+        reason = self.health_reason()
         if reason:
             return self._stop(reason)
         self._update_dt()
@@ -380,6 +380,14 @@ class Simulation:
     def _stop(self, reason: str) -> str:
         self.reason = f"t = {self.t:.6g} s, step {self.steps}: {reason}"
         return self.reason
+
+    def health_reason(self) -> str:
+        """The guards' reason to stop (``guards.check``), a density deviation with where its
+        largest value lies; '' when the state is sound."""
+        reason = guards.check(self.check_health(), self.scene.guards, self.scene.dp)
+        if reason.startswith("density deviation"):
+            reason += guards.worst_density(self.x, self.z, self.rho, self.kind, self.n_active, self.rho0)
+        return reason
 
     def check_health(self) -> np.ndarray:
         g = self.grid
