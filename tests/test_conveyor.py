@@ -370,7 +370,8 @@ def test_no_tension_holds_the_upstream_contact_line_that_weak_diffusion_loses():
     """dp = 2.25 mm, Ch = 1.8, delta = 0.05: the free-surface particle at the upstream wall is
     drawn into tension (rho/rho0 - 1 = -0.10 at x = 2.3 mm, z = 17 mm) and the density guard
     stops the run at 2.38 s (measured; 1.89-1.94 s from the film-depth start, for C 0.33-0.54).
-    With the fluid density floored at rho0 the largest deviation stays at 1.9 % through 2.6 s."""
+    With the fluid density floored at rho0 the largest deviation stays below 2.5 % through 2.6 s
+    (1.85 % measured to 2.4 s)."""
     from solver.simulation import Simulation
     case = coarse_conveyor_case(ch=1.8, density_diffusion=0.05, cfl=0.54, no_tension=True)
     assert worst_density_deviation(Simulation(build_scene(case)), 2.6) < 0.025
