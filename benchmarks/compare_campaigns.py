@@ -1,8 +1,9 @@
 """Two campaign datasets, case by case: each metric's change in units of their combined
 standard error, z = (new - old) / sqrt(se_new^2 + se_old^2), with status, steps and steady time.
 
-A solver change that should leave the physics alone (round-off, speed) passes when its
-campaign's metrics stay within their run-to-run spread, read here as |z| <= 2 for every value.
+A solver change that should leave the physics alone (round-off, speed) should leave its
+campaign's metrics within their run-to-run spread: |z| mostly within 2 (if the se describe that
+spread, noise alone puts about 1 value in 20 beyond it), and no case far beyond.
 
 Usage: python benchmarks/compare_campaigns.py NEW/results/campaign.nc OLD/results/campaign.nc
 """
