@@ -15,7 +15,7 @@ from solver import lubrication
 from solver.build import build_particles
 from solver.conveyor import build_scene, case_from_dict, initial_toe, scheme_fluid, wall_thickness
 from solver.scene import SceneError
-from tests.conftest import EXAMPLES, coarse_conveyor_case, worst_density_deviation
+from tests.conftest import EXAMPLES, coarse_conveyor_case, load_benchmark, worst_density_deviation
 
 
 def paper(**changes):
@@ -148,12 +148,8 @@ def test_time_to_solution_runs_the_fast_example_as_shipped():
     answer) runs examples/conveyor.yaml with overrides: they must give the fast example's case,
     its steady block included (its min_time 2 s, not conveyor.yaml's default 4 s), but for the
     name. ``fast`` keeps conveyor.yaml's 2 s average and nothing else of it."""
-    import importlib.util
     from solver.cli import apply_overrides
-    path = EXAMPLES.parent / "benchmarks" / "time_to_solution.py"
-    spec = importlib.util.spec_from_file_location("time_to_solution", path)
-    tts = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(tts)
+    tts = load_benchmark("time_to_solution")
     with open(EXAMPLES / "conveyor_fast.yaml") as fh:
         fast_d = yaml.safe_load(fh)
     for variant, average in (("fast_average_1s", 1.0), ("fast", 2.0)):

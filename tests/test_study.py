@@ -383,13 +383,10 @@ def test_zeta_f_error_is_the_scatter_of_the_last_second_toe_slope():
 def test_compare_campaigns_measures_changes_in_combined_standard_errors():
     """z = (new - old) / sqrt(se_new^2 + se_old^2), per case and metric: a zeta_h moved by
     3 se in both runs' units is z = 3 / sqrt(2), the only |z| above 2; others stay 0."""
-    import importlib.util
     from campaign_data import campaign
     from test_verdict import paper_like
-    spec = importlib.util.spec_from_file_location("compare_campaigns",
-                                                  ROOT / "benchmarks" / "compare_campaigns.py")
-    cc = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(cc)
+    from tests.conftest import load_benchmark
+    cc = load_benchmark("compare_campaigns")
     old = campaign(paper_like)
     for m in cc.METRICS:
         old[f"case_{m}_se"] = xr.full_like(old[f"case_{m}"], 0.001)
