@@ -273,224 +273,231 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                        strain_correction)
     DIAG = VOLC + 1 if volume else VOLC
 
-    @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-    def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
-        """acc[t, i, :] += the pair sums of the particles thread t writes (``PairFields`` f,
-        ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
-        with implicit viscosity, thread t's fluid pairs in row t of the ``PairList`` arrays
-        (passed one by one: numba 0.68 loses writes to arrays held in a tuple inside prange)."""
+    @nb.njit(cache=True, fastmath=FASTMATH)
+    def thread_pairs(t, f, cl, split, k, acc, pair_i, pair_j, pair_k):
+        """Thread t's share of ``pair_loop``: acc[t, i, :] = the pair sums of the particles of
+        its columns and of the next column; returns (max h |u_ab . r_ab| / (r^2 + eta^2), the
+        number of fluid pairs listed in row t of the ``PairList`` arrays)."""
         x, z, u, w, rho, p, mass, kind, irho = f.x, f.z, f.u, f.w, f.rho, f.p, f.mass, f.kind, f.irho
         start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
         h, nu, hc0, rho0 = k.h, k.nu, k.hc0, k.rho0
-        nt = split.size - 1
         fac = grad_coefficient(h)
         eta2 = ETA2 * h * h
         alpha = alpha_2d(h)
         four_h2 = 4.0 * h * h
         two_h = 2.0 * h
         inv_h = 1.0 / h
-        for t in nb.prange(nt):
-            at = acc[t]
-            lo, hi = thread_rows(start, split, t, ncx, ncz)
-            at[lo:hi] = 0.0
-            if periodic and split[t + 1] == ncx:
-                at[0:start[ncz]] = 0.0
-            vm = 0.0
-            npl = 0
-            cap = pair_i.shape[1]
-            for ix in range(split[t], split[t + 1]):
-                # half stencil: b > a in this column and every b of the next column, each
-                # within 2h of a in z. Columns are sorted by z (``cells.sort_cells_by``) and a
-                # walks its column upwards, so both z windows are ranges whose ends only move up
-                jx = ix + 1
-                next_shift = 0.0
-                has_next = True
-                if jx == ncx:
-                    has_next = periodic
-                    jx = 0
-                    next_shift = period
-                col_end = start[(ix + 1) * ncz]
-                own_hi = start[ix * ncz]
-                nx_lo = nx_hi = nx_end = 0
-                if has_next:
-                    nx_lo = nx_hi = start[jx * ncz]
-                    nx_end = start[(jx + 1) * ncz]
-                for iz in range(ncz):
-                    ca = ix * ncz + iz
-                    a0, a1 = start[ca], start[ca + 1]
-                    if a0 == a1:
-                        continue
-                    for a in range(a0, a1):
-                        xa, za, ua, wa = x[a], z[a], u[a], w[a]
-                        ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
-                        ira = irho[a]
-                        Va = ma * ira
-                        cell_a = f.cell[a]
-                        s_ax = s_az = s_drho = 0.0
-                        s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
-                        s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
-                        s_diag = 0.0
-                        s_lapg = s_supp = 0.0
-                        s_volc = 0.0
-                        sxa = sza = 0.0
-                        if shift_correction:
-                            sxa, sza = f.sdx[a], f.sdz[a]
-                        z_lo, z_hi = za - two_h, za + two_h
-                        own_hi = max(own_hi, a + 1)
-                        while own_hi < col_end and z[own_hi] < z_hi:
-                            own_hi += 1
-                        while nx_lo < nx_end and z[nx_lo] <= z_lo:
-                            nx_lo += 1
-                        nx_hi = max(nx_hi, nx_lo)
-                        while nx_hi < nx_end and z[nx_hi] < z_hi:
-                            nx_hi += 1
-                        for side in range(2):
-                            first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
-                            # unsigned: no negative-index wrap-around on the loads and stores of b
-                            for b in range(np.uint64(first), np.uint64(b1)):
-                                kb = kind[b]
-                                if ka + kb == 2:
-                                    continue
-                                dx = xa - (x[b] + shift)
-                                dz = za - z[b]
-                                r2 = dx * dx + dz * dz
-                                if r2 >= four_h2:
-                                    continue
-                                q = math.sqrt(r2) * inv_h
-                                F = grad_factor(q, fac)
-                                rb = rho[b]
-                                du = ua - u[b]
-                                dw = wa - w[b]
-                                vdotr = du * dx + dw * dz
-                                rdotg = F * r2
-                                mb = mass[b]
-                                irb = irho[b]
-                                Vb = mb * irb
-                                inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
-                                ca, cb = continuity_terms(ra, rb, F, vdotr)
-                                s_drho += ca * Vb
-                                drho_b = cb * Va
-                                # momentum: pressure and laminar viscosity
-                                pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
-                                if variable_viscosity:
-                                    nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
-                                    vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
+        at = acc[t]
+        lo, hi = thread_rows(start, split, t, ncx, ncz)
+        at[lo:hi] = 0.0
+        if periodic and split[t + 1] == ncx:
+            at[0:start[ncz]] = 0.0
+        vm = 0.0
+        npl = 0
+        cap = pair_i.shape[1]
+        for ix in range(split[t], split[t + 1]):
+            # half stencil: b > a in this column and every b of the next column, each
+            # within 2h of a in z. Columns are sorted by z (``cells.sort_cells_by``) and a
+            # walks its column upwards, so both z windows are ranges whose ends only move up
+            jx = ix + 1
+            next_shift = 0.0
+            has_next = True
+            if jx == ncx:
+                has_next = periodic
+                jx = 0
+                next_shift = period
+            col_end = start[(ix + 1) * ncz]
+            own_hi = start[ix * ncz]
+            nx_lo = nx_hi = nx_end = 0
+            if has_next:
+                nx_lo = nx_hi = start[jx * ncz]
+                nx_end = start[(jx + 1) * ncz]
+            for iz in range(ncz):
+                ca = ix * ncz + iz
+                a0, a1 = start[ca], start[ca + 1]
+                if a0 == a1:
+                    continue
+                for a in range(a0, a1):
+                    xa, za, ua, wa = x[a], z[a], u[a], w[a]
+                    ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
+                    ira = irho[a]
+                    Va = ma * ira
+                    cell_a = f.cell[a]
+                    s_ax = s_az = s_drho = 0.0
+                    s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
+                    s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
+                    s_diag = 0.0
+                    s_lapg = s_supp = 0.0
+                    s_volc = 0.0
+                    sxa = sza = 0.0
+                    if shift_correction:
+                        sxa, sza = f.sdx[a], f.sdz[a]
+                    z_lo, z_hi = za - two_h, za + two_h
+                    own_hi = max(own_hi, a + 1)
+                    while own_hi < col_end and z[own_hi] < z_hi:
+                        own_hi += 1
+                    while nx_lo < nx_end and z[nx_lo] <= z_lo:
+                        nx_lo += 1
+                    nx_hi = max(nx_hi, nx_lo)
+                    while nx_hi < nx_end and z[nx_hi] < z_hi:
+                        nx_hi += 1
+                    for side in range(2):
+                        first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
+                        # unsigned: no negative-index wrap-around on the loads and stores of b
+                        for b in range(np.uint64(first), np.uint64(b1)):
+                            kb = kind[b]
+                            if ka + kb == 2:
+                                continue
+                            dx = xa - (x[b] + shift)
+                            dz = za - z[b]
+                            r2 = dx * dx + dz * dz
+                            if r2 >= four_h2:
+                                continue
+                            q = math.sqrt(r2) * inv_h
+                            F = grad_factor(q, fac)
+                            rb = rho[b]
+                            du = ua - u[b]
+                            dw = wa - w[b]
+                            vdotr = du * dx + dw * dz
+                            rdotg = F * r2
+                            mb = mass[b]
+                            irb = irho[b]
+                            Vb = mb * irb
+                            inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
+                            ca, cb = continuity_terms(ra, rb, F, vdotr)
+                            s_drho += ca * Vb
+                            drho_b = cb * Va
+                            # momentum: pressure and laminar viscosity
+                            pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
+                            if variable_viscosity:
+                                nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
+                                vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
+                            else:
+                                vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
+                            if artificial:
+                                pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
+                            fx = -pt * dx + vt * du
+                            fz = -pt * dz + vt * dw
+                            s_ax += mb * fx
+                            s_az += mb * fz
+                            at[b, AX] -= ma * fx
+                            at[b, AZ] -= ma * fz
+                            if implicit:  # k_ab = -vt
+                                if ka + kb == 0:
+                                    if npl < cap:
+                                        pair_i[t, npl] = a
+                                        pair_j[t, npl] = b
+                                        pair_k[t, npl] = -vt
+                                    npl += 1
+                                    s_diag -= mb * vt
+                                    at[b, DIAG] -= ma * vt
+                                elif kb == 1:
+                                    s_diag -= implicit_walls * mb * vt
                                 else:
-                                    vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
-                                if artificial:
-                                    pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
-                                fx = -pt * dx + vt * du
-                                fz = -pt * dz + vt * dw
-                                s_ax += mb * fx
-                                s_az += mb * fz
-                                at[b, AX] -= ma * fx
-                                at[b, AZ] -= ma * fz
-                                if implicit:  # k_ab = -vt
-                                    if ka + kb == 0:
-                                        if npl < cap:
-                                            pair_i[t, npl] = a
-                                            pair_j[t, npl] = b
-                                            pair_k[t, npl] = -vt
-                                        npl += 1
-                                        s_diag -= mb * vt
-                                        at[b, DIAG] -= ma * vt
-                                    elif kb == 1:
-                                        s_diag -= implicit_walls * mb * vt
+                                    at[b, DIAG] -= implicit_walls * ma * vt
+                            vr = abs(h * vdotr * inv_r2e)
+                            if vr > vm:
+                                vm = vr
+                            if diffusion:
+                                if ka + kb == 0:  # fluid pairs only
+                                    g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
+                                    if column_reference:
+                                        ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
+                                        s_drho += ge * Vb
+                                        drho_b -= ge * Va
                                     else:
-                                        at[b, DIAG] -= implicit_walls * ma * vt
-                                vr = abs(h * vdotr * inv_r2e)
-                                if vr > vm:
-                                    vm = vr
-                                if diffusion:
-                                    if ka + kb == 0:  # fluid pairs only
-                                        g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
-                                        if column_reference:
-                                            ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
-                                            s_drho += ge * Vb
-                                            drho_b -= ge * Va
-                                        else:
-                                            ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
-                                            s_drho += ea * Vb
-                                            drho_b += eb * Va
-                                at[b, DRHO] += drho_b
-                                if shifting:
-                                    gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
-                                    cell_b = f.cell[b]
-                                    s_gcx += cell_b * gx
-                                    s_gcz += cell_b * gz
-                                    s_divr += cell_b * gdiv
-                                    at[b, GCX] -= cell_a * gx
-                                    at[b, GCZ] -= cell_a * gz
-                                    at[b, DIVR] += cell_a * gdiv
-                                    if kb == 1:
-                                        s_wnx -= F * f.wnx[b]
-                                        s_wnz -= F * f.wnz[b]
-                                    elif ka == 1:
-                                        at[b, WNX] -= F * f.wnx[a]
-                                        at[b, WNZ] -= F * f.wnz[a]
-                                if viscous_correction:
-                                    # gradW_ab = F r_ab; gradW_ba = -gradW_ab
-                                    s_vgx += Vb * F * dx
-                                    s_vgz += Vb * F * dz
-                                    at[b, VGX] -= Va * F * dx
-                                    at[b, VGZ] -= Va * F * dz
-                                    s_vdivr -= Vb * rdotg
-                                    at[b, VDIVR] -= Va * rdotg
-                                if velocity_gradient:
-                                    # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
-                                    s_dux -= Vb * du * F * dx
-                                    s_duz -= Vb * du * F * dz
-                                    s_dwx -= Vb * dw * F * dx
-                                    s_dwz -= Vb * dw * F * dz
-                                    at[b, DUX] -= Va * du * F * dx
-                                    at[b, DUZ] -= Va * du * F * dz
-                                    at[b, DWX] -= Va * dw * F * dx
-                                    at[b, DWZ] -= Va * dw * F * dz
-                                if strain_correction:
-                                    if ka + kb == 0:
-                                        lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
-                                        s_lapg += Vb * lg
-                                        at[b, LAPG] -= Va * lg
-                                        s_supp -= 0.5 * Vb * rdotg
-                                        at[b, SUPP] -= 0.5 * Va * rdotg
-                                if volume:
-                                    Wab = w_value(q, alpha)
-                                    s_volc += Vb * Wab
-                                    at[b, VOLC] += Va * Wab
-                                if shift_correction:
-                                    # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
-                                    e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
-                                    s_divdr += Vb * e
-                                    at[b, DIVDR] += Va * e
-                        at[a, AX] += s_ax
-                        at[a, AZ] += s_az
-                        at[a, DRHO] += s_drho
-                        if shifting:
-                            at[a, GCX] += s_gcx
-                            at[a, GCZ] += s_gcz
-                            at[a, DIVR] += s_divr
-                            at[a, WNX] += s_wnx
-                            at[a, WNZ] += s_wnz
-                        if shift_correction:
-                            at[a, DIVDR] += s_divdr
-                        if viscous_correction:
-                            at[a, VGX] += s_vgx
-                            at[a, VGZ] += s_vgz
-                            at[a, VDIVR] += s_vdivr
-                        if volume:
-                            at[a, VOLC] += s_volc
-                        if implicit:
-                            at[a, DIAG] += s_diag
-                        if strain_correction:
-                            at[a, LAPG] += s_lapg
-                            at[a, SUPP] += s_supp
-                        if velocity_gradient:
-                            at[a, DUX] += s_dux
-                            at[a, DUZ] += s_duz
-                            at[a, DWX] += s_dwx
-                            at[a, DWZ] += s_dwz
-            vmax[t] = vm
-            pair_count[t] = npl
+                                        ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
+                                        s_drho += ea * Vb
+                                        drho_b += eb * Va
+                            at[b, DRHO] += drho_b
+                            if shifting:
+                                gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
+                                cell_b = f.cell[b]
+                                s_gcx += cell_b * gx
+                                s_gcz += cell_b * gz
+                                s_divr += cell_b * gdiv
+                                at[b, GCX] -= cell_a * gx
+                                at[b, GCZ] -= cell_a * gz
+                                at[b, DIVR] += cell_a * gdiv
+                                if kb == 1:
+                                    s_wnx -= F * f.wnx[b]
+                                    s_wnz -= F * f.wnz[b]
+                                elif ka == 1:
+                                    at[b, WNX] -= F * f.wnx[a]
+                                    at[b, WNZ] -= F * f.wnz[a]
+                            if viscous_correction:
+                                # gradW_ab = F r_ab; gradW_ba = -gradW_ab
+                                s_vgx += Vb * F * dx
+                                s_vgz += Vb * F * dz
+                                at[b, VGX] -= Va * F * dx
+                                at[b, VGZ] -= Va * F * dz
+                                s_vdivr -= Vb * rdotg
+                                at[b, VDIVR] -= Va * rdotg
+                            if velocity_gradient:
+                                # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
+                                s_dux -= Vb * du * F * dx
+                                s_duz -= Vb * du * F * dz
+                                s_dwx -= Vb * dw * F * dx
+                                s_dwz -= Vb * dw * F * dz
+                                at[b, DUX] -= Va * du * F * dx
+                                at[b, DUZ] -= Va * du * F * dz
+                                at[b, DWX] -= Va * dw * F * dx
+                                at[b, DWZ] -= Va * dw * F * dz
+                            if strain_correction:
+                                if ka + kb == 0:
+                                    lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
+                                    s_lapg += Vb * lg
+                                    at[b, LAPG] -= Va * lg
+                                    s_supp -= 0.5 * Vb * rdotg
+                                    at[b, SUPP] -= 0.5 * Va * rdotg
+                            if volume:
+                                Wab = w_value(q, alpha)
+                                s_volc += Vb * Wab
+                                at[b, VOLC] += Va * Wab
+                            if shift_correction:
+                                # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
+                                e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
+                                s_divdr += Vb * e
+                                at[b, DIVDR] += Va * e
+                    at[a, AX] += s_ax
+                    at[a, AZ] += s_az
+                    at[a, DRHO] += s_drho
+                    if shifting:
+                        at[a, GCX] += s_gcx
+                        at[a, GCZ] += s_gcz
+                        at[a, DIVR] += s_divr
+                        at[a, WNX] += s_wnx
+                        at[a, WNZ] += s_wnz
+                    if shift_correction:
+                        at[a, DIVDR] += s_divdr
+                    if viscous_correction:
+                        at[a, VGX] += s_vgx
+                        at[a, VGZ] += s_vgz
+                        at[a, VDIVR] += s_vdivr
+                    if volume:
+                        at[a, VOLC] += s_volc
+                    if implicit:
+                        at[a, DIAG] += s_diag
+                    if strain_correction:
+                        at[a, LAPG] += s_lapg
+                        at[a, SUPP] += s_supp
+                    if velocity_gradient:
+                        at[a, DUX] += s_dux
+                        at[a, DUZ] += s_duz
+                        at[a, DWX] += s_dwx
+                        at[a, DWZ] += s_dwz
+        return vm, npl
+
+    @nb.njit(parallel=True, cache=True)
+    def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
+        """acc[t, i, :] = the pair sums of the particles thread t writes (``PairFields`` f,
+        ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
+        with implicit viscosity, thread t's fluid pairs in row t of the ``PairList`` arrays.
+        The threads' work is ``thread_pairs``, compiled without the parallel passes, which
+        would otherwise take most of the compile time on its long body."""
+        for t in nb.prange(split.size - 1):
+            # the gufunc types t as uint64 and the loop outside it as int64: one signature
+            vmax[t], pair_count[t] = thread_pairs(np.uint64(t), f, cl, split, k, acc, pair_i, pair_j, pair_k)
 
     return pair_loop
 
