@@ -244,7 +244,11 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "zeta_h, zeta_fs, zeta_u: a block jackknife over the window, zeta_h's with half the "
                "depth's drift through it). It is not the discretisation error, and the verdicts and "
                "the cheapest runs use it: a value is below a threshold only by more than 2 se, two "
-               "runs within 2 se tie.</p>")
+               "runs within 2 se tie. Nor does it hold the spread between realisations: rerun with "
+               "other rounding (another thread count), the default campaign's Lind runs and its "
+               "coarsest Skillen run at Ch = 1.3 moved zeta_fs and zeta_u by up to 6.8 times the two "
+               "runs' combined se, and no "
+               "verdict changed (docs/conveyor.md, \"Round-off realisations\").</p>")
     figs = []
     for path, title, caption in figures:
         data = base64.b64encode(Path(path).read_bytes()).decode()
