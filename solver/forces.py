@@ -493,8 +493,9 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         """acc[t, i, :] = the pair sums of the particles thread t writes (``PairFields`` f,
         ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
         with implicit viscosity, thread t's fluid pairs in row t of the ``PairList`` arrays.
-        The threads' work is ``thread_pairs``, compiled without the parallel passes, which
-        would otherwise take most of the compile time on its long body."""
+        The threads' work is ``thread_pairs``, compiled without the parallel passes: run on
+        its long body, they took about half of the loop's compile time
+        (benchmarks/compile_time.py)."""
         for t in nb.prange(split.size - 1):
             # the gufunc types t as uint64 and the loop outside it as int64: one signature
             vmax[t], pair_count[t] = thread_pairs(np.uint64(t), f, cl, split, k, acc, pair_i, pair_j, pair_k)
