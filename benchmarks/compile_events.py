@@ -7,6 +7,9 @@ it writes the sum and one line a function (seconds, compilations) to $COMPILE_EV
 (default compile_events.txt). Run with an empty cache to see the cold suite's compile time:
 
     SPH_SURGE_CACHE_DIR=$(mktemp -d) PYTHONPATH=benchmarks python -m pytest -q -p compile_events
+
+Imported elsewhere (``benchmarks/compile_time.py``), it records from the import on; ``totals``
+reads what it has recorded.
 """
 from __future__ import annotations
 
@@ -36,12 +39,18 @@ class _Timer(event.Listener):
 event.register("numba:compile", _Timer())
 
 
-def pytest_sessionfinish(session, exitstatus):
-    totals: dict[str, list] = collections.defaultdict(lambda: [0.0, 0])
+def totals() -> dict[str, list]:
+    """{function: [compile seconds, compilations]} of every compilation recorded so far."""
+    out: dict[str, list] = collections.defaultdict(lambda: [0.0, 0])
     for name, seconds in _records:
-        totals[name][0] += seconds
-        totals[name][1] += 1
+        out[name][0] += seconds
+        out[name][1] += 1
+    return dict(out)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    totals_ = totals()
     with open(os.environ.get("COMPILE_EVENTS_OUT", "compile_events.txt"), "w") as f:
-        f.write(f"compile seconds in all: {sum(v[0] for v in totals.values()):.1f}\n")
-        for name, (seconds, count) in sorted(totals.items(), key=lambda kv: -kv[1][0]):
+        f.write(f"compile seconds in all: {sum(v[0] for v in totals_.values()):.1f}\n")
+        for name, (seconds, count) in sorted(totals_.items(), key=lambda kv: -kv[1][0]):
             f.write(f"{seconds:8.2f} s {count:4d}x {name}\n")

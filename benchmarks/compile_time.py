@@ -2,8 +2,9 @@
 
 Each round runs, for each tree in turn (the order reversed every other round), a fresh process
 with an empty SPH_SURGE_CACHE_DIR that builds the case's simulation and takes one step, and
-times every numba compilation by numba's compile events. A compilation started inside another
-(a callee typed while its caller compiles) is counted in its caller's seconds. One JSON line a
+times every numba compilation by numba's compile events (benchmarks/compile_events.py). A
+compilation started inside another (a callee typed while its caller compiles) is counted in its
+caller's seconds. One JSON line a
 tree and round: the compile seconds summed, the process's wall seconds to the end of the step,
 and the slowest functions.
 
@@ -27,33 +28,13 @@ ROOT = Path(__file__).resolve().parents[1]
 CHILD = r"""
 import json, sys, time
 tic = time.perf_counter()
-from numba.core import event
-
-records = []
-
-
-class Timer(event.Listener):
-    def __init__(self):
-        self.open = []
-
-    def on_start(self, ev):
-        self.open.append(time.perf_counter())
-
-    def on_end(self, ev):
-        t0 = self.open.pop()
-        if not self.open:  # outermost only: nested compilations count in their caller
-            d = ev.data["dispatcher"]
-            records.append((d.py_func.__module__ + "." + d.py_func.__qualname__,
-                            time.perf_counter() - t0))
-
-
-event.register("numba:compile", Timer())
 spec = json.loads(sys.argv[1])
+sys.path.insert(0, spec["benchmarks"])
+import compile_events  # records every compilation from here on
 import numba
 numba.set_num_threads(spec["threads"])
 from solver.simulation import Simulation
 if spec["layer"]:
-    sys.path.insert(0, spec["benchmarks"])
     from throughput import layer_scene
     from solver.scene import scene_from_dict
     scene = scene_from_dict(layer_scene(float(spec["layer"][0]), spec["layer"][1], 4000))
@@ -64,9 +45,7 @@ else:
     scene = build_scene(case_from_dict(apply_overrides(read_yaml(spec["case"]), spec["set"])))
 sim = Simulation(scene)
 sim.step()
-totals = {}
-for name, seconds in records:
-    totals[name] = totals.get(name, 0.0) + seconds
+totals = {name: seconds for name, (seconds, count) in compile_events.totals().items()}
 print(json.dumps({"compile_s": sum(totals.values()), "wall_s": time.perf_counter() - tic,
                   "functions": totals}))
 """
