@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import functools
 import math
+import types
 from typing import NamedTuple
 
 import numba as nb
@@ -488,7 +489,9 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                         at[a, DWZ] += s_dwz
         return vm, npl
 
-    @nb.njit(parallel=True, cache=True)
+    switches = (diffusion, shifting, shift_correction, column_reference, viscous_correction,
+                artificial, variable_viscosity, implicit_walls, strain_correction, volume)
+
     def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
         """acc[t, i, :] = the pair sums of the particles thread t writes (``PairFields`` f,
         ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
@@ -496,11 +499,18 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         The threads' work is ``thread_pairs``, compiled without the parallel passes: run on
         its long body, they took about half of the loop's compile time
         (benchmarks/compile_time.py)."""
+        switches  # noqa: B018 -- in the closure, so that each variant has its own cache entry
         for t in nb.prange(split.size - 1):
             # the gufunc types t as uint64 and the loop outside it as int64: one signature
-            vmax[t], pair_count[t] = thread_pairs(np.uint64(t), f, cl, split, k, acc, pair_i, pair_j, pair_k)
+            vmax[t], pair_count[t] = _thread_pairs(  # noqa: F821 -- a global given below
+                np.uint64(t), f, cl, split, k, acc, pair_i, pair_j, pair_k)
 
-    return pair_loop
+    # The kernel is a global of pair_loop alone, not a closure variable: numba's cache key
+    # includes the closure's contents, and a dispatcher pickles with a random id, so that the
+    # loop would be compiled afresh in every process.
+    pair_loop = types.FunctionType(pair_loop.__code__, dict(globals(), _thread_pairs=thread_pairs),
+                                   pair_loop.__name__, None, pair_loop.__closure__)
+    return nb.njit(parallel=True, cache=True)(pair_loop)
 
 
 @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
