@@ -62,3 +62,29 @@ def test_editing_an_inlined_helper_recompiles(tmp_path):
     doubled, dir3 = _probe(root, cache)
     assert doubled == pytest.approx(2.0 * w0, rel=1e-12), "stale machine code was loaded"
     assert dir3 != dir1
+
+
+# Two variants of the pair loop, built in one process; prints how often the pair loop compiled.
+VARIANTS = """
+import sys
+sys.path.insert(0, sys.argv[1])
+import compile_events
+from throughput import layer_scene
+from solver.scene import scene_from_dict
+from solver.simulation import Simulation
+for shifting in ("skillen", "none"):
+    Simulation(scene_from_dict(layer_scene(1.5, shifting, 2000))).step()
+print(sum(n for name, (seconds, n) in compile_events.totals().items() if "pair_loop" in name))
+"""
+
+
+def test_a_second_process_loads_the_pair_loops_from_the_cache():
+    """Numba keys a cached closure on its closure's contents; a dispatcher there would pickle
+    with a random id and make every process compile the loop afresh."""
+    bench = SOLVER_DIR.parent / "benchmarks"
+    env = dict(os.environ, NUMBA_NUM_THREADS="2")
+    runs = [subprocess.run([sys.executable, "-c", VARIANTS, str(bench)], env=env, capture_output=True,
+                           text=True, timeout=600) for _ in range(2)]
+    for res in runs:
+        assert res.returncode == 0, res.stderr
+    assert int(runs[1].stdout.split()[-1]) == 0, "the second process compiled the pair loop again"
