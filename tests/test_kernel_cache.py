@@ -64,17 +64,22 @@ def test_editing_an_inlined_helper_recompiles(tmp_path):
     assert dir3 != dir1
 
 
-# Two variants of the pair loop, built in one process; prints how often the pair loop compiled.
+# Two variants of the pair loop, built in one process; prints how often the pair loop compiled,
+# and how often an uncached function defined here did (1 when the compile events are seen).
 VARIANTS = """
 import sys
 sys.path.insert(0, sys.argv[1])
 import compile_events
+import numba
 from throughput import layer_scene
 from solver.scene import scene_from_dict
 from solver.simulation import Simulation
 for shifting in ("skillen", "none"):
     Simulation(scene_from_dict(layer_scene(1.5, shifting, 2000))).step()
-print(sum(n for name, (seconds, n) in compile_events.totals().items() if "pair_loop" in name))
+numba.njit(lambda v: v + 1)(1)
+counts = compile_events.totals()
+print(sum(n for name, (seconds, n) in counts.items() if "pair_loop" in name),
+      sum(n for name, (seconds, n) in counts.items() if "lambda" in name))
 """
 
 
@@ -87,4 +92,6 @@ def test_a_second_process_loads_the_pair_loops_from_the_cache():
                            text=True, timeout=600) for _ in range(2)]
     for res in runs:
         assert res.returncode == 0, res.stderr
-    assert int(runs[1].stdout.split()[-1]) == 0, "the second process compiled the pair loop again"
+    pair_loops, probe = (int(v) for v in runs[1].stdout.split()[-2:])
+    assert probe == 1, "the compile events were not seen"
+    assert pair_loops == 0, "the second process compiled the pair loop again"
