@@ -22,6 +22,15 @@ from .steady import SteadyCriteria
 START_SHAPES = ("block", "lubrication", "warm")
 START_VELOCITIES = ("rest", "lubrication")
 START_DEPTHS = ("film", "theory")
+MAX_PERTURBATION = 0.01  # of dp: a realisation's start differs by rounding-sized moves, not a new start
+
+
+def perturb_start(x: np.ndarray, z: np.ndarray, amplitude: float, seed: int) -> None:
+    """Move each point by independent uniform offsets in [-amplitude, amplitude] in x and z
+    (in place), drawn from numpy's default generator seeded with ``seed``."""
+    rng = np.random.default_rng(seed)
+    x += rng.uniform(-amplitude, amplitude, x.size)
+    z += rng.uniform(-amplitude, amplitude, z.size)
 
 
 @dataclass
@@ -91,6 +100,10 @@ class ConveyorCase(YamlData):
     start_depth: str = "film"  # lubrication start: film (the scheme's own normal depth) or theory
     start_velocity: str = "rest"  # or lubrication: the steady film profile, belt running from t = 0
     warm_from: str | None = None  # start: warm: a front run's NetCDF (another dp) to start from
+    # a realisation of the run: every fluid particle's start position moved by up to
+    # start_perturbation dp in x and in z (uniform, drawn with perturbation_seed); 0: none
+    start_perturbation: float = 0.0
+    perturbation_seed: int = 0
     wall_height: float = 2.5  # upstream wall, in h_n
     normalising_depth: float = 0.0186  # m: the paper's h_n used to normalise its data
     coefsound: float = 10.0
@@ -208,6 +221,11 @@ def validate_case(c: ConveyorCase) -> None:
                          "leave start_velocity at rest")
     if c.start_depth not in START_DEPTHS:
         raise SceneError(f"case.start_depth: {c.start_depth!r} is not one of {', '.join(START_DEPTHS)}")
+    if not 0.0 <= c.start_perturbation <= MAX_PERTURBATION:
+        raise SceneError(f"case.start_perturbation: must lie in [0, {MAX_PERTURBATION:g}] (a fraction of dp), "
+                         f"got {c.start_perturbation!r}")
+    if c.perturbation_seed < 0:
+        raise SceneError(f"case.perturbation_seed: must be an integer >= 0, got {c.perturbation_seed!r}")
     if c.start == "warm" and not c.warm_from:
         raise SceneError("case.warm_from: start: warm needs the path of a front run (NetCDF) to start from")
     positive(c.belt.speed, "case.belt.speed")

@@ -1,7 +1,8 @@
 """A miniature campaign end to end: Snakemake -> per-case NetCDF -> campaign.nc -> report.
 
-Three very coarse, short cases; one is forced to diverge (cfl = 5) and must be shown as such
-while the campaign completes. Then: changing a figure setting reruns no simulation.
+Two very coarse, short grid cases in two realisations each, and one extra case forced to
+diverge (cfl = 5), which must be shown as such while the campaign completes. Then: changing a
+figure setting reruns no simulation.
 """
 import subprocess
 import sys
@@ -47,6 +48,14 @@ def test_campaign_dataset(campaign):
     on_grid = ds.sel(ch=1.5, shifting="skillen")
     assert np.all(on_grid["status"].values == "completed")
     assert np.all(np.isfinite(on_grid["zeta_h"].values))
+    # two realisations a grid point: the perturbed start gives another run, and the grid
+    # point holds their mean
+    assert ds["realisations"].values.ravel().tolist() == [2, 2] and ds.attrs["realisations"] == 2
+    for dp in ("4", "3.5"):
+        a, b = (list(ds["case"].values).index(f"dp{dp}mm_ch1.5_skillen{r}") for r in ("", "_r1"))
+        pair = ds["case_zeta_fs"].values[[a, b]]
+        assert pair[0] != pair[1]
+        assert float(on_grid["zeta_fs"].sel(dp=float(dp) / 1000)) == pytest.approx(pair.mean(), rel=1e-12)
 
 
 def test_report_has_every_section(campaign):

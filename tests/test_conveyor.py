@@ -371,3 +371,21 @@ def test_no_tension_holds_the_upstream_contact_line_that_weak_diffusion_loses():
     from solver.simulation import Simulation
     case = coarse_conveyor_case(ch=1.8, density_diffusion=0.05, cfl=0.54, no_tension=True)
     assert worst_density_deviation(Simulation(build_scene(case)), 2.6) < 0.025
+
+
+def test_a_start_perturbation_moves_each_point_by_at_most_its_amplitude_and_is_seeded():
+    from solver.conveyor import case_from_dict, perturb_start
+    from solver.scene import SceneError
+    rng = np.random.default_rng(7)
+    x0, z0 = rng.uniform(0, 1, 5000), rng.uniform(0, 1, 5000)
+    moved = [(x0.copy(), z0.copy()) for _ in range(3)]
+    for (x, z), seed in zip(moved, (1, 1, 2)):
+        perturb_start(x, z, 1e-6, seed)
+    dx, dz = moved[0][0] - x0, moved[0][1] - z0
+    assert np.abs(dx).max() <= 1e-6 * (1 + 1e-9) and np.abs(dz).max() <= 1e-6 * (1 + 1e-9)
+    assert np.abs(dx).max() > 0.99e-6 and abs(np.mean(dx)) < 0.05e-6  # uniform on [-a, a]
+    assert np.array_equal(moved[0][0], moved[1][0]) and not np.array_equal(moved[0][0], moved[2][0])
+    with pytest.raises(SceneError, match="case.start_perturbation"):
+        case_from_dict({"dp": 2.5e-3, "start_perturbation": 0.02})
+    with pytest.raises(SceneError, match="case.perturbation_seed"):
+        case_from_dict({"dp": 2.5e-3, "perturbation_seed": -1})

@@ -1,6 +1,7 @@
 """The study: grid naming, config schema, reference, metrics on synthetic fields, workflow."""
 import functools
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -29,7 +30,6 @@ def test_float_safe_names():
     assert fmt(np.float64(1.0)) == "1"
     assert case_id(0.00025, 1.3, "lind") == "dp0.25mm_ch1.3_lind"
     assert case_id(0.1 + 0.2, 1.8000000000000003, "skillen") == "dp300mm_ch1.8_skillen"
-    import re
     assert re.fullmatch(CASE_ID, case_id(0.00025, 2.2, "skillen", "coarse-start"))
     assert not re.fullmatch(CASE_ID, "dp1e-3mm_ch1.8_lind")
 
@@ -81,6 +81,9 @@ def test_configs_validate_and_expand():
     ({"figures": {"dpi": "high"}}, "figures.dpi"),
     ({"metricz": {}}, "(top level)"),
     ({"case": {"dp": 0.001}}, "case"),
+    ({"ensemble": {"realisations": 0}}, "ensemble.realisations"),
+    ({"ensemble": {"realisations": 2.5}}, "ensemble.realisations"),
+    ({"ensemble": {"perturbation": 0.5}}, "ensemble.perturbation"),
 ])
 def test_schema_errors_name_the_key(change, key):
     c = load("config.yaml")
@@ -398,3 +401,42 @@ def test_compare_campaigns_measures_changes_in_combined_standard_errors():
     assert rows[moved]["z"]["zeta_h"] == pytest.approx([3.0 / math.sqrt(2.0)])
     z = cc.largest(rows)
     assert (z > 2).sum() == 1 and z.size == (new.sizes["case"] - 1) * (3 + new.sizes["station"])
+
+
+def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
+    """Realisation 0 is the case as configured (the same solver file as without an ensemble,
+    so its finished run is kept); realisation k moves the start by the configured amplitude
+    with seed k; extra cases run once; a warm start chains within a realisation."""
+    from study.config import case_dict, cases, validate, warm_source
+    base = {"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind"]},
+            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}]}
+    single = validate(base)
+    cfg = validate({**base, "ensemble": {"realisations": 3, "perturbation": 1.0e-5}, "warm_start": True})
+    ids = [c.id for c in cases(cfg)]
+    assert ids == ["dp3mm_ch1.5_lind", "dp3mm_ch1.5_lind_r1", "dp3mm_ch1.5_lind_r2",
+                   "dp2mm_ch1.5_lind", "dp2mm_ch1.5_lind_r1", "dp2mm_ch1.5_lind_r2", "dp2mm_ch1.5_lind_x"]
+    assert all(re.fullmatch(CASE_ID, i) for i in ids)
+    by_id = {c.id: c for c in cases(cfg)}
+    assert by_id["dp2mm_ch1.5_lind_r2"].on_grid and not by_id["dp2mm_ch1.5_lind_x"].on_grid
+    assert case_dict(cfg, by_id["dp3mm_ch1.5_lind"]) == case_dict(single, cases(single)[0])
+    d = case_dict(cfg, by_id["dp3mm_ch1.5_lind_r2"])
+    assert (d["start_perturbation"], d["perturbation_seed"]) == (1.0e-5, 2)
+    assert "start_perturbation" not in case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_r1"]).id == "dp3mm_ch1.5_lind_r1"
+    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-6}
+
+
+def test_the_ensemble_mean_and_its_error():
+    """se = sqrt(max(s^2, mean se_i^2) / n): the realisations' spread where it exceeds the
+    windows' own error, the windows' error (averaged down) where the realisations agree."""
+    from study.campaign import ensemble_mean
+    v, se = ensemble_mean(np.array([0.062, 0.086, 0.070, 0.080]), np.array([0.001, 0.003, 0.002, 0.002]))
+    assert v == pytest.approx(0.0745, rel=1e-12)
+    assert se == pytest.approx(np.std([0.062, 0.086, 0.070, 0.080], ddof=1) / 2.0, rel=1e-12)
+    v, se = ensemble_mean(np.array([0.05, 0.05]), np.array([0.01, 0.01]))
+    assert (v, se) == (pytest.approx(0.05), pytest.approx(0.01 / np.sqrt(2.0)))
+    assert ensemble_mean(np.array([0.05]), np.array([0.01])) == (0.05, 0.01)  # one realisation: as it is
+    assert ensemble_mean(np.array([0.05, np.nan]), np.array([0.01, np.nan])) == (0.05, 0.01)  # one finite
+    v, se = ensemble_mean(np.array([[1.0, 2.0], [3.0, np.nan]]))  # per station, no window errors
+    assert v.tolist() == [2.0, 2.0] and se[0] == pytest.approx(1.0) and np.isnan(se[1])
+    assert all(np.isnan(ensemble_mean(np.array([np.nan, np.nan]))))

@@ -1,5 +1,6 @@
 """Reduce per-case results into the campaign dataset: dimensions (dp, ch, shifting) for the
-grid, and a flat ``case`` table of every case (grid and extra)."""
+grid (a grid point's realisations averaged, ``ensemble_mean``), and a flat ``case`` table of
+every case (grid, its realisations, and extra)."""
 from __future__ import annotations
 
 import numpy as np
@@ -50,6 +51,38 @@ def _front_particles(run: xr.Dataset, max_n: int):
     return px, pz, pv, py
 
 
+def _metric(m: xr.Dataset, k: str):
+    """Metric k of one case's metrics dataset (NaN where absent: metrics written before it)."""
+    return m[k].values if k in m else np.nan
+
+
+def ensemble_mean(values: np.ndarray, errors: np.ndarray | None = None) -> tuple:
+    """(mean, se) of one metric over n realisations (axis 0; NaN where a realisation has none).
+
+    With one finite value, that value and its se. With n > 1, the mean of the finite values and
+    se = sqrt(max(s^2, mean se_i^2) / n): s^2 is their sample variance, which holds the spread
+    between realisations that a single window's se_i does not; the mean of the se_i^2 bounds it
+    from below, so that a few realisations that happen to agree do not claim a smaller error
+    than each window's own sampling gives. NaN where no value is finite."""
+    values = np.asarray(values, dtype=float)
+    shape = values.shape[1:]
+    errors = np.full(values.shape, np.nan) if errors is None else \
+        np.broadcast_to(np.asarray(errors, dtype=float), values.shape)
+    ok = np.isfinite(values)
+    n = ok.sum(axis=0)
+    safe_n = np.maximum(n, 1)
+    mean = np.where(n > 0, np.where(ok, values, 0.0).sum(axis=0) / safe_n, np.nan)
+    var = np.where(ok, (values - mean) ** 2, 0.0).sum(axis=0) / np.maximum(n - 1, 1)
+    within_ok = ok & np.isfinite(errors)
+    within = np.where(within_ok, errors ** 2, 0.0).sum(axis=0) / np.maximum(within_ok.sum(axis=0), 1)
+    se = np.sqrt(np.maximum(var, within) / safe_n)
+    single = np.where(ok, errors, 0.0).sum(axis=0)  # the one finite value's se
+    se = np.where(n > 1, se, np.where(n == 1, single, np.nan))
+    if not shape:
+        return float(mean), float(se)
+    return mean.reshape(shape), se.reshape(shape)
+
+
 def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
           front_particles: int = 4000) -> xr.Dataset:
     """The campaign dataset from each case's run and metrics datasets (same order)."""
@@ -79,25 +112,42 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     reason = np.full(shape, "", dtype=object)
     case_ids = np.full(shape, "", dtype=object)
 
+    n_real = np.zeros(shape, dtype=int)
+    cells: dict[tuple, list] = {}
     for c, run, m in zip(cases, runs, metrics):
-        if not c.on_grid:
-            continue
-        ix = (dps.index(c.dp), chs.index(c.ch), shs.index(c.shifting))
-        for k in SCALARS:
-            data[k][ix] = float(m[k]) if k in m else np.nan  # metrics written before their se
-        for k in STATION_METRICS:
-            data[k][ix] = m[k].values if k in m else np.nan
-        for k, (attr, _, _) in RUN_NUMBERS.items():
-            data[k][ix] = float(run.attrs.get(attr, np.nan))
-        if "mean_surface_elevation" in run and run.attrs["status"] != "diverged":
-            data["uniform_depth"][ix] = float(run["mean_uniform_depth"]) / run.attrs["h_n_m"]
-            data["mean_surface"][ix] = run["mean_surface_elevation"].values / run.attrs["h_n_m"]
-            data["mean_velocity"][ix] = run["mean_velocity_star"].values
+        if c.on_grid:
+            cells.setdefault((dps.index(c.dp), chs.index(c.ch), shs.index(c.shifting)), []).append((c, run, m))
+    for ix, members in cells.items():
+        members.sort(key=lambda cm: cm[0].realisation)
+        c, run, m = members[0]  # realisation 0: the case as configured
+        n_real[ix] = len(members)
+        for k in SCALARS + STATION_METRICS:
+            if k.endswith("_se"):
+                continue
+            cell = data[k][ix].shape
+            values = np.array([np.broadcast_to(_metric(mm, k), cell) for _, _, mm in members])
+            errors = (np.array([np.broadcast_to(_metric(mm, f"{k}_se"), cell) for _, _, mm in members])
+                      if f"{k}_se" in data else None)
+            data[k][ix], se = ensemble_mean(values, errors)
+            if errors is not None:
+                data[f"{k}_se"][ix] = se
+        for k, (attr, _, _) in RUN_NUMBERS.items():  # a run's cost: the mean over the realisations
+            data[k][ix] = np.mean([float(r.attrs.get(attr, np.nan)) for _, r, _ in members])
+        means = [r for _, r, _ in members if "mean_surface_elevation" in r and r.attrs["status"] != "diverged"]
+        if means:
+            data["uniform_depth"][ix] = np.mean([float(r["mean_uniform_depth"]) / r.attrs["h_n_m"] for r in means])
+            data["mean_surface"][ix] = np.mean([r["mean_surface_elevation"].values / r.attrs["h_n_m"]
+                                                for r in means], axis=0)
+            data["mean_velocity"][ix] = np.mean([r["mean_velocity_star"].values for r in means], axis=0)
         if run.attrs["status"] != "diverged":  # a diverged run keeps no final state
             (data["front_x"][ix], data["front_z"][ix], data["front_speed"][ix],
              data["front_yielded"][ix]) = _front_particles(run, front_particles)
-        status[ix], reason[ix], case_ids[ix] = run.attrs["status"], run.attrs["reason"], c.id
-        steady[ix] = float(m["steady"])
+        # the grid point counts as completed and steady only if every realisation is
+        worst = next(((cc, r) for cc, r, _ in members if r.attrs["status"] != "completed"), (c, run))
+        status[ix], reason[ix], case_ids[ix] = worst[1].attrs["status"], worst[1].attrs["reason"], c.id
+        if worst[0] is not c and reason[ix]:
+            reason[ix] = f"{worst[0].id}: {reason[ix]}"
+        steady[ix] = min(float(mm["steady"]) for _, _, mm in members)
 
     dims = ("dp", "ch", "shifting")
     ds = xr.Dataset(
@@ -113,7 +163,8 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
          "steady": (dims, steady, {"units": "1", "long_name": "1: metrics from a steady window"}),
          "status": (dims, status.astype(str)),
          "reason": (dims, reason.astype(str)),
-         "case_id": (dims, case_ids.astype(str))},
+         "case_id": (dims, case_ids.astype(str)),
+         "realisations": (dims, n_real, {"units": "1", "long_name": "realisations averaged (ensemble)"})},
         coords={"dp": ("dp", np.array(dps), {"units": "m", "long_name": "particle spacing"}),
                 "ch": ("ch", np.array(chs), {"units": "1", "long_name": "h / dp"}),
                 "shifting": ("shifting", np.array(shs, dtype=str)),

@@ -73,7 +73,7 @@ def validate(config: dict) -> dict:
     if errors:  # every problem at once, each naming its key
         raise ConfigError("; ".join(f"config key {_path(e)}: {e.message}" for e in errors))
     try:
-        cases = expand(cfg["grid"], cfg.get("extra_cases"))
+        cases = expand(cfg["grid"], cfg.get("extra_cases"), realisations(cfg))
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     # every case must make a valid solver case: check now, before any job starts
@@ -93,7 +93,12 @@ def load(path) -> dict:
 
 
 def cases(cfg: dict) -> list[Case]:
-    return expand(cfg["grid"], cfg.get("extra_cases"))
+    return expand(cfg["grid"], cfg.get("extra_cases"), realisations(cfg))
+
+
+def realisations(cfg: dict) -> int:
+    """Realisations of each grid case (``ensemble.realisations``; 1 where the key is absent)."""
+    return int((cfg.get("ensemble") or {}).get("realisations", 1))
 
 
 def _merge(base: dict, changes: dict) -> dict:
@@ -107,12 +112,12 @@ def _merge(base: dict, changes: dict) -> dict:
 
 
 def warm_source(cfg: dict, case: Case) -> Case | None:
-    """With ``warm_start``: the grid case at the next coarser dp with the same Ch and
-    shifting, whose final state starts this one; None for the coarsest and extra cases."""
+    """With ``warm_start``: the grid case at the next coarser dp with the same Ch, shifting
+    and realisation, whose final state starts this one; None for the coarsest and extra cases."""
     if not cfg.get("warm_start") or not case.on_grid:
         return None
     coarser = [c for c in cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
-               and c.dp > case.dp]
+               and c.realisation == case.realisation and c.dp > case.dp]
     return min(coarser, key=lambda c: c.dp) if coarser else None
 
 
@@ -141,6 +146,8 @@ def case_dict(cfg: dict, case: Case) -> dict:
     if src is not None:
         d.update(start="warm", warm_from=run_path(src))
     d.update(name=case.id, dp=case.dp, ch=case.ch, shifting=case.shifting)
+    if case.realisation:
+        d.update(start_perturbation=cfg["ensemble"]["perturbation"], perturbation_seed=case.realisation)
     for cfg_path, case_path in SOLVER_KEYS.items():  # the metrics read what the runs probed
         node = d
         for key in case_path[:-1]:

@@ -13,9 +13,11 @@ def fmt(x: float, digits: int = 6) -> str:
     return "0" if s in ("-0", "") else s
 
 
-def case_id(dp: float, ch: float, shifting: str, tag: str | None = None) -> str:
-    """E.g. dp1mm_ch1.8_lind; dp in mm."""
+def case_id(dp: float, ch: float, shifting: str, tag: str | None = None, realisation: int = 0) -> str:
+    """E.g. dp1mm_ch1.8_lind; dp in mm; realisation k > 0 of a grid case ends in _rk."""
     cid = f"dp{fmt(dp * 1000.0)}mm_ch{fmt(ch)}_{shifting}"
+    if realisation:
+        tag = f"r{realisation}"
     return f"{cid}_{tag}" if tag else cid
 
 
@@ -26,10 +28,11 @@ class Case:
     shifting: str
     tag: str | None = None
     overrides: dict = field(default_factory=dict, compare=False, hash=False)
+    realisation: int = 0  # grid cases only: 0 runs the case as configured, k > 0 a perturbed start
 
     @property
     def id(self) -> str:
-        return case_id(self.dp, self.ch, self.shifting, self.tag)
+        return case_id(self.dp, self.ch, self.shifting, self.tag, self.realisation)
 
     @property
     def on_grid(self) -> bool:
@@ -43,10 +46,10 @@ def matches(selector: dict, dp: float, ch: float, shifting: str) -> bool:
     return all(values[k] == (v if k == "shifting" else float(v)) for k, v in selector.items())
 
 
-def expand(grid: dict, extra: list[dict] | None = None) -> list[Case]:
+def expand(grid: dict, extra: list[dict] | None = None, realisations: int = 1) -> list[Case]:
     """Cases of the grid (``combine``: product, or paper = every Ch with the first shifting
-    method plus every method at ``paper_ch``), less those matching an ``exclude`` entry,
-    followed by the extra cases; ids unique."""
+    method plus every method at ``paper_ch``), less those matching an ``exclude`` entry, each
+    in ``realisations`` realisations (0, 1, ...), followed by the extra cases; ids unique."""
     dps, chs, shifts = grid["dp"], grid["ch"], grid["shifting"]
     combine = grid.get("combine", "product")
     excluded = grid.get("exclude") or []
@@ -62,7 +65,7 @@ def expand(grid: dict, extra: list[dict] | None = None) -> list[Case]:
                     continue
                 if left_out(float(dp), float(ch), sh):
                     continue
-                cases.append(Case(float(dp), float(ch), sh))
+                cases.extend(Case(float(dp), float(ch), sh, realisation=k) for k in range(realisations))
     for e in extra or []:
         cases.append(Case(float(e["dp"]), float(e["ch"]), e["shifting"], e.get("tag"),
                           dict(e.get("overrides") or {})))

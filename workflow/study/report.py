@@ -223,6 +223,21 @@ def stability_section(ds: xr.Dataset) -> str:
     return text
 
 
+def ensemble_paragraph(ds: xr.Dataset) -> str:
+    """What a grid point's value and se are when the campaign ran an ensemble; empty without."""
+    n = int(ds.attrs.get("realisations", 1))
+    if n <= 1:
+        return ""
+    amp = float(ds.attrs.get("start_perturbation", np.nan))
+    return (f"<p><b>Ensemble:</b> every grid case ran in {n} realisations, the case as configured and "
+            f"{n - 1} with each fluid particle's start moved by up to {amp:g} dp (ids ending in _r1, "
+            "_r2, ...; all in the case table). A grid point's metrics are the means over its "
+            "realisations, and its se is sqrt(max(s<sup>2</sup>, mean se<sub>i</sub><sup>2</sup>) / n): "
+            "s, the realisations' spread, holds what one window's se misses; the windows' own se "
+            "bound it from below. A grid point counts as completed and steady only if every "
+            "realisation is. Its wall time is a realisation's mean.</p>")
+
+
 def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: str,
            extra_sections: list[tuple[str, str]] = ()) -> str:
     """HTML text; ``figures`` as (image path, title, caption); images are embedded."""
@@ -248,7 +263,8 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "other rounding (another thread count), the default campaign's Lind runs and its "
                "coarsest Skillen run at Ch = 1.3 moved zeta_fs and zeta_u by up to 6.8 times the two "
                "runs' combined se, and no "
-               "verdict changed (docs/conveyor.md, \"Round-off realisations\").</p>")
+               "verdict changed (docs/conveyor.md, \"Round-off realisations\").</p>"
+               + ensemble_paragraph(ds))
     figs = []
     for path, title, caption in figures:
         data = base64.b64encode(Path(path).read_bytes()).decode()
