@@ -91,3 +91,13 @@ def test_the_report_in_a_real_browser(tmp_path):
                    '<img alt="outside" src="http://example.invalid/x.png"></body></html>')
     r = check_report(bad)
     assert r.broken == ["broken", "outside"] and r.external == ["http://example.invalid/x.png"]
+
+
+def test_an_ensemble_campaign_says_what_its_grid_values_and_errors_are():
+    ds = campaign(paper_like)
+    assert "Ensemble:" not in render(ds, [], "grid: {}")  # one realisation: nothing to say
+    ds["realisations"] = xr.full_like(ds["wall_time"], 3, dtype=int)
+    ds.attrs.update(realisations=3, start_perturbation=1e-6)
+    text = render(ds, [], "grid: {}")
+    assert "every grid case ran in 3 realisations" in text and "moved by up to 1e-06 dp" in text
+    assert f"{ds.sizes['case']} cases (every grid case in 3 realisations: {ds['wall_time'].size} grid points)" in text

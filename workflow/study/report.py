@@ -263,7 +263,8 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "other rounding (another thread count), the default campaign's Lind runs and its "
                "coarsest Skillen run at Ch = 1.3 moved zeta_fs and zeta_u by up to 6.8 times the two "
                "runs' combined se, and no "
-               "verdict changed (docs/conveyor.md, \"Round-off realisations\").</p>"
+               "verdict changed (docs/conveyor.md, \"Round-off realisations\"). The campaign key "
+               "ensemble runs each grid case in several realisations and puts their spread into the se.</p>"
                + ensemble_paragraph(ds))
     figs = []
     for path, title, caption in figures:
@@ -297,7 +298,11 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     question = ("Does this campaign reproduce the conclusions of Lapillonne et al. (SPHERIC 2022)?"
                 if newtonian else f"A {html.escape(ds.attrs['rheology'])} fluid: how close are its fronts to "
                 "the lubrication reference, and at what cost?")
-    lead = (f"<p class='lead'>{n} cases, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
+    n_real = int(ds.attrs.get("realisations", 1))
+    ensemble = "" if n_real <= 1 else (
+        f" (every grid case in {n_real} realisations: {int(np.sum(ds['realisations'].values > 0))} grid points)"
+        if "realisations" in ds else f" (every grid case in {n_real} realisations)")
+    lead = (f"<p class='lead'>{n} cases{ensemble}, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
             f"{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
