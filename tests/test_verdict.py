@@ -235,3 +235,21 @@ def test_zeta_fs_does_not_converge_within_its_sampling_error():
     ds["zeta_fs_se"] = xr.full_like(ds["zeta_fs"], 0.02)
     v = by_claim(ds)["zeta_fs"]
     assert v.verdict == "not reproduced" and v.evidence.count("(flat)") == 3
+
+
+def test_with_an_ensemble_the_cheapest_is_a_grid_point_by_its_ensemble_mean():
+    """An ensemble's accuracy table judges grid points (their realisations' mean and se, at a
+    realisation's mean cost), not single realisations."""
+    from study.verdict import accuracy_rows
+    ds = campaign(paper_like)
+    ds["case_zeta_h"] = ds["case_zeta_h"] * 100.0  # single runs that would all miss
+    assert next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_h")["cheapest"][0.05] is None
+    ds["realisations"] = xr.full_like(ds["wall_time"], 2, dtype=int)
+    ds["zeta_h_se"] = xr.full_like(ds["zeta_h"], 1e-4)
+    ds.attrs["realisations"] = 2
+    row = next(r for r in accuracy_rows(ds) if r["metric"] == "zeta_h")
+    grid = ds.stack(point=("dp", "ch", "shifting"))
+    ok = (grid["steady"].values > 0) & (grid["zeta_h"].values + 2e-4 <= 0.05)
+    i = np.flatnonzero(ok)[np.argmin(grid["wall_time"].values[ok])]
+    assert row["cheapest"][0.05] == (str(grid["case_id"].values[i]), float(grid["wall_time"].values[i]),
+                                     float(grid["zeta_h"].values[i]), pytest.approx(2e-4))

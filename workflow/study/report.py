@@ -172,7 +172,9 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
                                                      for t in thresholds)
             + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
             "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
-    return ("<p>The cheapest steady run (wall time, error) meeting each threshold over the whole "
+    what = ("run (wall time, error)" if int(ds.attrs.get("realisations", 1)) <= 1 else
+            "grid point (a realisation's mean wall time, the realisations' mean error and the ensemble's se)")
+    return (f"<p>The cheapest steady {what} meeting each threshold over the whole "
             "grid (with its sampling error: below by more than 2 se); then, at the paper's "
             "Ch, the metric at the finest dp, its Richardson limit with the GCI band of the finest "
             "value (Celik et al. 2008; only for monotone sequences over the three finest dp) and "
