@@ -423,7 +423,7 @@ def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
     assert (d["start_perturbation"], d["perturbation_seed"]) == (1.0e-5, 2)
     assert "start_perturbation" not in case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])
     assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_r1"]).id == "dp3mm_ch1.5_lind_r1"
-    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-6}
+    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-3}
 
 
 def test_the_ensemble_mean_and_its_error():
