@@ -101,3 +101,4 @@ def test_an_ensemble_campaign_says_what_its_grid_values_and_errors_are():
     text = render(ds, [], "grid: {}")
     assert "every grid case ran in 3 realisations" in text and "moved by up to 1e-06 dp" in text
     assert f"{ds.sizes['case']} cases (every grid case in 3 realisations: {ds['wall_time'].size} grid points)" in text
+    assert "cheapest steady grid point &le; 0.01" in text

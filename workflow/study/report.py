@@ -168,7 +168,8 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
                   f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
         out.append("<tr>" + "".join(cells) + "</tr>")
     ch = rows[0]["ch"] if rows else float("nan")
-    head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady run &le; {t:g}</th>"
+    unit = "run" if int(ds.attrs.get("realisations", 1)) <= 1 else "grid point"
+    head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady {unit} &le; {t:g}</th>"
                                                      for t in thresholds)
             + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
             "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
