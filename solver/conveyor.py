@@ -25,12 +25,11 @@ START_DEPTHS = ("film", "theory")
 MAX_PERTURBATION = 0.01  # of dp: a realisation's start differs by rounding-sized moves, not a new start
 
 
-def perturb_start(x: np.ndarray, z: np.ndarray, amplitude: float, seed: int) -> None:
-    """Move each point by independent uniform offsets in [-amplitude, amplitude] in x and z
-    (in place), drawn from numpy's default generator seeded with ``seed``."""
+def start_offsets(n: int, amplitude: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(dx, dz): independent uniform offsets in [-amplitude, amplitude] for n points, drawn
+    from numpy's default generator seeded with ``seed``."""
     rng = np.random.default_rng(seed)
-    x += rng.uniform(-amplitude, amplitude, x.size)
-    z += rng.uniform(-amplitude, amplitude, z.size)
+    return rng.uniform(-amplitude, amplitude, n), rng.uniform(-amplitude, amplitude, n)
 
 
 @dataclass

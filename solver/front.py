@@ -16,7 +16,7 @@ import xarray as xr
 
 from . import film_depth, film_fit, steady
 from .build import build_particles
-from .conveyor import ConveyorCase, build_scene, lubrication_velocity, perturb_start, scheme_fluid
+from .conveyor import ConveyorCase, build_scene, lubrication_velocity, scheme_fluid, start_offsets
 from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, last_crossing, toe_position
 from .run import Runner
@@ -461,9 +461,9 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     parts = build_particles(scene)
     f = parts.kind == 0
     if case.start_perturbation > 0.0:
-        xf, zf = parts.x[f], parts.z[f]
-        perturb_start(xf, zf, case.start_perturbation * case.dp, case.perturbation_seed)
-        parts.x[f], parts.z[f] = xf, zf
+        dx, dz = start_offsets(int(f.sum()), case.start_perturbation * case.dp, case.perturbation_seed)
+        parts.x[f] += dx
+        parts.z[f] += dz
     if state is not None:
         parts.u[f], parts.w[f] = state.velocity_at(parts.x[f], parts.z[f])
     elif case.start_velocity == "lubrication":

@@ -51,6 +51,11 @@ def _front_particles(run: xr.Dataset, max_n: int):
     return px, pz, pv, py
 
 
+def ensemble_size(ds: xr.Dataset) -> int:
+    """Realisations each grid point of a campaign dataset averages (1: no ensemble)."""
+    return int(ds.attrs.get("realisations", 1))
+
+
 def _metric(m: xr.Dataset, k: str):
     """Metric k of one case's metrics dataset (NaN where absent: metrics written before it)."""
     return m[k].values if k in m else np.nan

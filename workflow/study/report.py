@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .campaign import ensemble_size
+
 CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;
 padding:0 1em;color:#222}
@@ -168,13 +170,14 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
                   f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
         out.append("<tr>" + "".join(cells) + "</tr>")
     ch = rows[0]["ch"] if rows else float("nan")
-    unit = "run" if int(ds.attrs.get("realisations", 1)) <= 1 else "grid point"
+    ensemble = ensemble_size(ds) > 1
+    unit = "grid point" if ensemble else "run"
     head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady {unit} &le; {t:g}</th>"
                                                      for t in thresholds)
             + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
             "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
-    what = ("run (wall time, error)" if int(ds.attrs.get("realisations", 1)) <= 1 else
-            "grid point (a realisation's mean wall time, the realisations' mean error and the ensemble's se)")
+    what = ("grid point (a realisation's mean wall time, the realisations' mean error and the ensemble's se)"
+            if ensemble else "run (wall time, error)")
     return (f"<p>The cheapest steady {what} meeting each threshold over the whole "
             "grid (with its sampling error: below by more than 2 se); then, at the paper's "
             "Ch, the metric at the finest dp, its Richardson limit with the GCI band of the finest "
@@ -228,7 +231,7 @@ def stability_section(ds: xr.Dataset) -> str:
 
 def ensemble_paragraph(ds: xr.Dataset) -> str:
     """What a grid point's value and se are when the campaign ran an ensemble; empty without."""
-    n = int(ds.attrs.get("realisations", 1))
+    n = ensemble_size(ds)
     if n <= 1:
         return ""
     amp = float(ds.attrs.get("start_perturbation", np.nan))
@@ -301,10 +304,9 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     question = ("Does this campaign reproduce the conclusions of Lapillonne et al. (SPHERIC 2022)?"
                 if newtonian else f"A {html.escape(ds.attrs['rheology'])} fluid: how close are its fronts to "
                 "the lubrication reference, and at what cost?")
-    n_real = int(ds.attrs.get("realisations", 1))
+    n_real = ensemble_size(ds)
     ensemble = "" if n_real <= 1 else (
-        f" (every grid case in {n_real} realisations: {int(np.sum(ds['realisations'].values > 0))} grid points)"
-        if "realisations" in ds else f" (every grid case in {n_real} realisations)")
+        f" (every grid case in {n_real} realisations: {int(np.sum(ds['realisations'].values > 0))} grid points)")
     lead = (f"<p class='lead'>{n} cases{ensemble}, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
             f"{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)

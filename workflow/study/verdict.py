@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
+from .campaign import ensemble_size
 from .convergence import gci
 
 PAPER_CH = 1.8
@@ -393,16 +394,13 @@ def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
     wall time, value, 2 se or None)."""
     from .pareto import cheapest_meeting
     ch = paper_ch(ds)
-    ensemble = int(ds.attrs.get("realisations", 1)) > 1 and "realisations" in ds
-    if ensemble:  # a grid point's ensemble mean and se, at a realisation's mean cost
-        grid = ds.stack(point=("dp", "ch", "shifting"))
-        names = grid["case_id"].values
-        cost = np.where(grid["steady"].values > 0, grid["wall_time"].values, np.nan)
+    if ensemble_size(ds) > 1:  # a grid point's ensemble mean and se, at a realisation's mean cost
+        table, prefix = ds.stack(point=("dp", "ch", "shifting")), ""
+        names = table["case_id"].values
     else:  # every run, extra cases included
+        table, prefix = ds, "case_"
         names = ds["case"].values
-        cost = np.where(ds["case_steady"].values > 0, ds["case_wall_time"].values, np.nan)
-    prefix = "" if ensemble else "case_"
-    table = grid if ensemble else ds
+    cost = np.where(table[f"{prefix}steady"].values > 0, table[f"{prefix}wall_time"].values, np.nan)
     rows = []
     for var, dim in METRICS:
         stations = ds["station"].values if dim else [None]
