@@ -3,7 +3,12 @@ from snakemake.utils import min_version
 
 min_version("8.0")
 
-configfile: "config/config.yaml"
+# The default campaign, unless --configfile names another: a campaign file is complete in
+# itself, so that the default's grid exclusions, case_overrides and case keys never merge into
+# it (--config KEY=VALUE still edits whichever campaign runs).
+if not workflow.overwrite_configfiles:
+
+    configfile: "config/config.yaml"
 
 
 include: "workflow/rules/common.smk"

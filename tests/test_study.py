@@ -2,6 +2,7 @@
 import functools
 import math
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -72,6 +73,25 @@ def test_configs_validate_and_expand():
     assert {c.dp for c in cs} == {0.001, 0.0005, 0.00025}
     assert {c.ch for c in cs} == {1.0, 1.3, 1.5, 1.8, 2.2}
     assert {c.ch for c in cs if c.shifting == "lind"} == {1.8}
+
+
+def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_eight_realisations():
+    """config/accuracy.yaml: realisation 0 of each case has the default campaign's case file
+    exactly (so that a finished default run is kept), the others its perturbed starts."""
+    default = cfgmod.validate(load("config.yaml"))
+    acc = cfgmod.validate(load("accuracy.yaml"))
+    cs = cfgmod.cases(acc)
+    assert len(cs) == 16 and {c.realisation for c in cs} == set(range(8))
+    assert {(c.dp, c.ch) for c in cs} == {(0.001, 1.8)} and {c.shifting for c in cs} == {"skillen", "lind"}
+    base = {c.id: cfgmod.case_dict(default, c) for c in cfgmod.cases(default) if c.dp == 0.001}
+    for c in cs:
+        d = cfgmod.case_dict(acc, c)
+        if c.realisation == 0:
+            assert d == base[c.id], c.id
+        else:
+            stem = c.id.rsplit("_r", 1)[0]
+            extra = {"name": c.id, "start_perturbation": 1e-3, "perturbation_seed": c.realisation}
+            assert d == {**base[stem], **extra}, c.id
 
 
 @pytest.mark.parametrize("change, key", [
@@ -302,6 +322,10 @@ def test_rms_does_not_bridge_gaps():
 
 # ---- workflow -------------------------------------------------------------------------------
 def dry_run(configfile, tmp_path):
+    """The job counts of a dry run from a directory that holds config/config.yaml, as the
+    repository does: a campaign given by --configfile must not take the default's settings."""
+    (tmp_path / "config").mkdir(exist_ok=True)
+    shutil.copy(ROOT / "config" / "config.yaml", tmp_path / "config" / "config.yaml")
     p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-n",
                         "--configfile", str(configfile), "--quiet", "rules"],
                        cwd=tmp_path, capture_output=True, text=True)
@@ -315,7 +339,7 @@ def dry_run(configfile, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18)])
+@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18), ("accuracy.yaml", 16)])
 def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     counts = dry_run(ROOT / "config" / name, tmp_path)
     assert counts["run_case"] == n and counts["metrics"] == n and counts["case_file"] == n
