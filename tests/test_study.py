@@ -129,6 +129,26 @@ def test_exponent_notation_reads_as_a_number():
         cfgmod.validate(raw)
 
 
+def test_command_line_strings_read_as_the_schema_types():
+    """snakemake --config passes nested values as strings (its YAML base loader): the campaign
+    reads integers and booleans where the schema expects them, and refuses what is neither."""
+    c = load("config.yaml")
+    c.update(ensemble={"realisations": "4", "perturbation": "1e-3"}, figures={"dpi": "90"})
+    cfg = cfgmod.validate(c)
+    assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001}
+    assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40
+    schema = cfgmod.load_schema()
+    assert cfgmod.coerce_numbers({"warm_start": "True"}, schema) == {"warm_start": True}
+    for key, bad in (("realisations", "4.5"), ("realisations", "four")):
+        c["ensemble"] = {key: bad}
+        with pytest.raises(cfgmod.ConfigError, match=f"config key ensemble.{key}:"):
+            cfgmod.validate(c)
+    c["ensemble"] = {}
+    c["warm_start"] = "yes"
+    with pytest.raises(cfgmod.ConfigError, match="config key warm_start:"):
+        cfgmod.validate(c)
+
+
 def test_solver_level_errors_are_caught_before_jobs():
     c = load("config.yaml")
     c["case"]["steady"]["average"] = 0.1

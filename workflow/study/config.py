@@ -35,15 +35,25 @@ def _path(err) -> str:
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_INTEGER = re.compile(r"[-+]?\d+")
+_BOOLEAN = {"true": True, "false": False}
 
 
 def coerce_numbers(value, schema: dict):
-    """``value`` with every string that the schema types as a number read as one: YAML 1.1
-    (PyYAML, Snakemake's loader) reads ``3e-3`` as a string, YAML 1.2 and users as 3e-3."""
+    """``value`` with every string that the schema types as a number, an integer or a boolean
+    read as one: YAML 1.1 (PyYAML, Snakemake's loader) reads ``3e-3`` as a string, YAML 1.2 and
+    users as 3e-3; ``snakemake --config 'ensemble={realisations: 4}'`` passes every nested value
+    as a string."""
     types = schema.get("type")
     types = [types] if isinstance(types, str) else (types or [])
-    if isinstance(value, str) and "number" in types and _NUMBER.fullmatch(value.strip()):
-        return float(value)
+    if isinstance(value, str):
+        text = value.strip()
+        if "integer" in types and _INTEGER.fullmatch(text):
+            return int(text)
+        if "number" in types and _NUMBER.fullmatch(text):
+            return float(text)
+        if "boolean" in types and text.lower() in _BOOLEAN:
+            return _BOOLEAN[text.lower()]
     if isinstance(value, dict):
         props = schema.get("properties", {})
         return {k: coerce_numbers(v, props[k]) if k in props else v for k, v in value.items()}
