@@ -132,6 +132,21 @@ def test_the_cheapest_run_under_a_threshold_honours_the_sampling_error():
         assert (row["cheapest"][0.05] is not None) == (se == 0.004)  # 0.7 % + 0.8 % is below 5 %
 
 
+def test_the_accuracy_table_gives_the_finest_value_with_its_sampling_error():
+    from study.report import accuracy_table
+    from study.verdict import accuracy_rows
+    ds = campaign(paper_like)
+    if "zeta_f_se" in ds:
+        ds = ds.drop_vars("zeta_f_se")
+    assert all(r["finest_two_se"] == 0 for r in accuracy_rows(ds) if r["metric"] == "zeta_f")
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.0015)
+    rows = [r for r in accuracy_rows(ds) if r["metric"] == "zeta_f"]
+    assert len(rows) == 2 and all(r["finest_two_se"] == pytest.approx(0.003) for r in rows)
+    assert accuracy_table(ds).count("&plusmn; 0.003<") == 2
+    ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], np.nan)
+    assert accuracy_table(ds).count("&plusmn; (se unknown)") == 2
+
+
 def test_a_zeta_f_within_its_sampling_error_of_the_threshold_is_not_below_it():
     """The paper-like campaign (zeta_f 0.6-0.7 % at the finest dp) with a sampling error of
     zeta_f of 0.3 %: 2 se = 0.6 % reaches past 1 %, so the claim is not reproduced, and lind's

@@ -166,7 +166,11 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
                     else f"{x.dp_needed * 1000:.3g} mm")
         else:
             lim, need = html.escape(x.status), "&ndash;"
-        cells += [f'<td class="l">{html.escape(r["shifting"])}</td>', f"<td>{_fmt(x.finest)}</td>",
+        two_se = r["finest_two_se"]
+        finest = _fmt(x.finest) + ("" if two_se == 0 or not np.isfinite(x.finest)
+                                   else " &plusmn; (se unknown)" if not np.isfinite(two_se)
+                                   else f" &plusmn; {_fmt(two_se, 2)}")
+        cells += [f'<td class="l">{html.escape(r["shifting"])}</td>', f"<td>{finest}</td>",
                   f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
         out.append("<tr>" + "".join(cells) + "</tr>")
     ch = rows[0]["ch"] if rows else float("nan")
@@ -174,7 +178,7 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
     unit = "grid point" if ensemble else "run"
     head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady {unit} &le; {t:g}</th>"
                                                      for t in thresholds)
-            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp</th>"
+            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp &plusmn; 2 se</th>"
             "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
     what = ("grid point (a realisation's mean wall time, the realisations' mean error and the ensemble's se)"
             if ensemble else "run (wall time, error)")

@@ -391,7 +391,8 @@ def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
     each its realisations' mean at a realisation's mean cost; a metric with a sampling error,
     ``case_{var}_se``, meets it only when below by more than 2 se), the GCI limit and band, and the
     dp that the observed order says is needed for 1 %. ``cheapest[thr]`` is None or (case,
-    wall time, value, 2 se or None)."""
+    wall time, value, 2 se or None); ``finest_two_se`` is 2 se of the value at the finest dp (0
+    where the campaign has no se of the metric, NaN where it could not be measured)."""
     from .pareto import cheapest_meeting
     ch = paper_ch(ds)
     if ensemble_size(ds) > 1:  # a grid point's ensemble mean and se, at a realisation's mean cost
@@ -418,6 +419,8 @@ def accuracy_rows(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> list[dict]:
                                                         None if two_se is None else float(two_se[i]))
             for sh in ds["shifting"].values:
                 da = _series(ds, var, ch, sh, x)
+                dp = _finest_dp(da)
                 rows.append(dict(metric=label, shifting=str(sh), ch=ch, cheapest=cheapest,
-                                 extrapolation=extrapolate(da["dp"].values, da.values, 0.01)))
+                                 extrapolation=extrapolate(da["dp"].values, da.values, 0.01),
+                                 finest_two_se=math.nan if dp is None else 2.0 * _se(ds, var, dp, ch, sh, x)))
     return rows
