@@ -169,7 +169,7 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
         two_se = r["finest_two_se"]
         finest = _fmt(x.finest) + ("" if two_se == 0 or not np.isfinite(x.finest)
                                    else " &plusmn; (se unknown)" if not np.isfinite(two_se)
-                                   else f" &plusmn; {_fmt(two_se, 2)}")
+                                   else f" &plusmn; {two_se:.2g}")
         cells += [f'<td class="l">{html.escape(r["shifting"])}</td>', f"<td>{finest}</td>",
                   f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
         out.append("<tr>" + "".join(cells) + "</tr>")
