@@ -11,7 +11,9 @@ wall particles below z = 0, as the no-slip mDBC mirror gives), evaluates the ter
 
 and prints its mean over bed rows (z < 2h), the interior and the surface rows (z > H - 2h) as
 a fraction of the exact nu U'' = -g sin theta: the operator's effective nu / nu on that
-arrangement. The same for a square lattice of the same depth. It also prints the interior
+arrangement, without and with the consistent laminar term's correction (minus 2 nu G . grad u
+where div r >= 1.9, ``forces.correct_viscous_term``). The same for a square lattice of the same
+depth. It also prints the interior
 means of M_zz = -sum_b V_b F_ab z_ab^2 and h G_z = h sum_b V_b F_ab z_ab, which give the
 operator's response by Taylor expansion: M_zz + 2 G_z U'/U'' with U'/U'' = -(H - z).
 Masses are taken as rho0 dp^2 (the runs store densities, not masses: within 1 %).
@@ -28,6 +30,7 @@ import xarray as xr
 import yaml
 
 from solver.conveyor import case_from_dict
+from solver.forces import VISCOUS_CORRECTION_MIN_DIVR
 from solver.kernel import grad_coefficient
 
 
@@ -39,17 +42,29 @@ def operator_response(x, z, kind, rho, mass, h, nu, g_s, depth, bands):
     u = film(z)
     fac = grad_coefficient(h)
     eta2 = 0.01 * h * h
+    volume = mass / rho
     out = {}
     for name, idx in bands.items():
-        acc = []
+        acc, cor = [], []
         for a in idx:
             d2 = (x - x[a]) ** 2 + (z - z[a]) ** 2
             nb = np.flatnonzero((d2 < 4 * h * h) & (d2 > 0))
             r2 = d2[nb]
             F = fac * (1 - np.sqrt(r2) / h / 2) ** 3
             vt = 4 * nu * F * r2 / ((rho[a] + rho[nb]) * (r2 + eta2))
-            acc.append((mass[nb] * vt * (u[a] - u[nb])).sum() / (-g_s))
-        out[name] = (float(np.mean(acc)), float(np.std(acc)), len(idx))
+            raw = (mass[nb] * vt * (u[a] - u[nb])).sum()
+            # the consistent laminar term (forces.correct_viscous_term): minus 2 nu G . grad u
+            # where div r = -sum V F r^2 >= 1.9, G = sum V F r_ab, grad u = sum V (u_b - u_a) F r_ab
+            dx, dz, V = x[a] - x[nb], z[a] - z[nb], volume[nb]
+            if -(V * F * r2).sum() >= VISCOUS_CORRECTION_MIN_DIVR:
+                gx, gz = (V * F * dx).sum(), (V * F * dz).sum()
+                dux, duz = (V * (u[nb] - u[a]) * F * dx).sum(), (V * (u[nb] - u[a]) * F * dz).sum()
+                raw_c = raw - 2 * nu * (gx * dux + gz * duz)
+            else:
+                raw_c = raw
+            acc.append(raw / (-g_s))
+            cor.append(raw_c / (-g_s))
+        out[name] = (float(np.mean(acc)), float(np.std(acc)), len(idx), float(np.mean(cor)))
     return out
 
 
@@ -72,7 +87,9 @@ def report(path):
     ds = xr.open_dataset(path)
     hn, dp, h = ds.attrs["h_n_m"], float(ds.attrs["dp"]), float(ds.attrs["h"])
     rho0 = float(ds.attrs["rho0"])
-    case = case_from_dict(yaml.safe_load(ds.attrs["case_yaml"]))
+    data = yaml.safe_load(ds.attrs["case_yaml"])
+    data.pop("start_perturbation", None)  # an experiment's start beyond the key's cap reads too
+    case = case_from_dict(data)
     nu = case.viscosity / case.density
     g_s = case.gravity * math.sin(case.theta)
     s = ds.isel(snapshot=-1)
@@ -100,13 +117,15 @@ def report(path):
         "bed rows": np.flatnonzero(mid & (lk == 0) & (lz < 2 * h)),
         "interior": np.flatnonzero(mid & (lk == 0) & (lz >= 2 * h) & (lz <= H - 2 * h)),
         "surface rows": np.flatnonzero(mid & (lk == 0) & (lz > H - 2 * h))})
-    print(f"\n{path}: {case.get('shifting')}, dp = {dp * 1e3:g} mm, t = {float(ds.attrs['simulated_time_s']):.2f} s, "
+    print(f"\n{path}: {case.shifting}, dp = {dp * 1e3:g} mm, t = {float(ds.attrs['simulated_time_s']):.2f} s, "
           f"depth {depth / hn:.4f} h_n")
-    print("  effective nu / nu of the viscous term (mean, spread, particles):")
+    print("  effective nu / nu of the viscous term (mean, spread, particles; then with the consistent"
+          " correction):")
     for name in res:
-        a, b, n = res[name]
-        la = lat[name][0]
-        print(f"    {name:13s} run arrangement {a:.3f} (sd {b:.2f}, {n})   lattice {la:.3f}")
+        a, b, n, c = res[name]
+        la, lc = lat[name][0], lat[name][3]
+        print(f"    {name:13s} run arrangement {a:.3f} (sd {b:.2f}, {n}), corrected {c:.3f}   "
+              f"lattice {la:.3f}, corrected {lc:.3f}")
     print(f"  interior: h <G_z> = {hgz:+.4f}, <M_zz> = {mzz:.4f}; Taylor prediction M_zz + 2 G_z U'/U'' = {pred:.3f}")
 
 
