@@ -138,7 +138,7 @@ def test_command_line_strings_read_as_the_schema_types():
     assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001}
     assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40
     schema = cfgmod.load_schema()
-    assert cfgmod.coerce_numbers({"warm_start": "True"}, schema) == {"warm_start": True}
+    assert cfgmod.coerce_scalars({"warm_start": "True"}, schema) == {"warm_start": True}
     for key, bad in (("realisations", "4.5"), ("realisations", "four")):
         c["ensemble"] = {key: bad}
         with pytest.raises(cfgmod.ConfigError, match=f"config key ensemble.{key}:"):

@@ -39,7 +39,7 @@ _INTEGER = re.compile(r"[-+]?\d+")
 _BOOLEAN = {"true": True, "false": False}
 
 
-def coerce_numbers(value, schema: dict):
+def coerce_scalars(value, schema: dict):
     """``value`` with every string that the schema types as a number, an integer or a boolean
     read as one: YAML 1.1 (PyYAML, Snakemake's loader) reads ``3e-3`` as a string, YAML 1.2 and
     users as 3e-3; ``snakemake --config 'ensemble={realisations: 4}'`` passes every nested value
@@ -56,9 +56,9 @@ def coerce_numbers(value, schema: dict):
             return _BOOLEAN[text.lower()]
     if isinstance(value, dict):
         props = schema.get("properties", {})
-        return {k: coerce_numbers(v, props[k]) if k in props else v for k, v in value.items()}
+        return {k: coerce_scalars(v, props[k]) if k in props else v for k, v in value.items()}
     if isinstance(value, list) and isinstance(schema.get("items"), dict):
-        return [coerce_numbers(v, schema["items"]) for v in value]
+        return [coerce_scalars(v, schema["items"]) for v in value]
     return value
 
 
@@ -69,7 +69,7 @@ def validate(config: dict) -> dict:
     """
     import jsonschema
     schema = load_schema()
-    cfg = coerce_numbers(copy.deepcopy(config), schema)
+    cfg = coerce_scalars(copy.deepcopy(config), schema)
     validator_cls = jsonschema.validators.validator_for(schema)
 
     def set_defaults(validator, properties, instance, schema):  # fill defaults while validating
