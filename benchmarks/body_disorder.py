@@ -16,8 +16,8 @@ Three commands:
       core's disorder.
 
 Usage: python benchmarks/body_disorder.py film examples/conveyor_fast.yaml 4 0.2 shifting=lind
-       python benchmarks/body_disorder.py run examples/conveyor_fast.yaml 0.1 out.nc shifting=lind \
-           steady.stop=false steady.max_time=8
+       python benchmarks/body_disorder.py run examples/conveyor_fast.yaml 0.1 out.nc
+           shifting=lind steady.stop=false steady.max_time=8   (one line)
        python benchmarks/body_disorder.py table out.nc
 """
 from __future__ import annotations
@@ -115,7 +115,7 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] not in ("film", "run", "table"):
         print(__doc__)
-        return 2
+        return 0 if argv and argv[0] in ("-h", "--help") else 2
     numba.set_num_threads(1)
     cmd, rest = argv[0], argv[1:]
     if cmd == "film":
