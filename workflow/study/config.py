@@ -62,6 +62,20 @@ def coerce_scalars(value, schema: dict):
     return value
 
 
+GRID_KEYS = ("dp", "ch", "shifting", "name")  # each case's own: not in case nor case_overrides
+
+
+def _message(err) -> str:
+    """The schema's message, or for a case mapping that sets what the grid sets, which keys."""
+    if err.validator == "not" and isinstance(err.instance, dict):
+        found = [k for k in GRID_KEYS if k in err.instance]
+        if found:
+            return (f"sets {', '.join(found)}, which each case takes from the grid (grid.dp, grid.ch, "
+                    "grid.shifting; the name from its case id); remove it here, or add an extra_cases "
+                    "entry for a single case")
+    return err.message
+
+
 def validate(config: dict) -> dict:
     """Validate against the JSON schema (filling defaults) and check what a schema cannot.
 
@@ -81,11 +95,14 @@ def validate(config: dict) -> dict:
     Defaulting = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
     errors = sorted(Defaulting(schema).iter_errors(cfg), key=lambda e: list(e.absolute_path))
     if errors:  # every problem at once, each naming its key
-        raise ConfigError("; ".join(f"config key {_path(e)}: {e.message}" for e in errors))
+        raise ConfigError("; ".join(f"config key {_path(e)}: {_message(e)}" for e in errors))
     try:
         cases = expand(cfg["grid"], cfg.get("extra_cases"), realisations(cfg))
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
+    if not cases:
+        raise ConfigError("config key grid.exclude: it leaves out every combination of grid.dp, grid.ch "
+                          "and grid.shifting, and extra_cases is empty: there is no case to run")
     # every case must make a valid solver case: check now, before any job starts
     from solver.conveyor import case_from_dict
     from solver.scene import SceneError
