@@ -118,6 +118,11 @@ def test_schema_errors_name_the_key(change, key):
         assert "which each case takes from the grid" in str(exc.value) and "anyOf" not in str(exc.value)
 
 
+def test_a_campaign_without_case_keys_is_told_what_case_holds():
+    with pytest.raises(cfgmod.ConfigError, match=r"config key \(top level\): 'case' is required.*case: \{\}"):
+        cfgmod.validate({"grid": {"dp": [0.002], "ch": [1.8], "shifting": ["lind"]}})
+
+
 def test_exponent_notation_reads_as_a_number():
     """PyYAML (and Snakemake's config loader) reads 3e-3 as a string; the campaign reads it
     as the number a user means, wherever the schema expects a number."""

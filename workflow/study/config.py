@@ -67,6 +67,11 @@ GRID_KEYS = ("dp", "ch", "shifting", "name")  # each case's own: not in case nor
 
 def _message(err) -> str:
     """The schema's message, or for a case mapping that sets what the grid sets, which keys."""
+    if err.validator == "required" and not err.absolute_path and "'case'" in err.message:
+        return ("'case' is required: the solver-case keys every run shares (docs/conveyor.md); "
+                "case: {} runs SPEC's scheme as written, config/config.yaml's case keys the shipped "
+                "scheme. A file given by --configfile is complete in itself: nothing is taken from "
+                "config/config.yaml")
     if err.validator == "not" and isinstance(err.instance, dict):
         found = [k for k in GRID_KEYS if k in err.instance]
         if found:
