@@ -71,3 +71,17 @@ def test_sampling_error_bars_on_every_point_that_has_one():
             station=float(ax.get_title().split("= ")[1])).values)
         np.testing.assert_allclose(sorted(top), [m + 0.002 for m in mid], rtol=1e-12)
     plt.close(fig)
+
+
+def test_every_caption_reads_as_plain_restructured_text():
+    """Snakemake's report parses the captions as reStructuredText: |u| and u*_f must come out as
+    written, with no substitution or emphasis and no docutils error (it printed two)."""
+    from docutils.core import publish_doctree
+    from docutils.nodes import system_message
+
+    from study.figures import FIGURES, rst_text
+    assert rst_text("|u*_f - u*_b| / u*_b") == r"\|u\*\_f - u\*\_b\| / u\*\_b"
+    for spec in FIGURES:
+        tree = publish_doctree(spec.caption_rst(1.8), settings_overrides={"report_level": 5, "halt_level": 5})
+        assert not list(tree.findall(system_message)), spec.name
+        assert tree.astext().strip() == f"{spec.title}. {spec.full_caption(1.8)}", spec.name

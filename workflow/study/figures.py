@@ -2,6 +2,7 @@
 (matplotlib, colour-blind safe), and their registry ``FIGURES``."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -42,8 +43,14 @@ class FigureSpec:
         return self.caption.format(ch=profile_ch) + (HOLLOW if self.hollow else "")
 
     def caption_rst(self, profile_ch: float) -> str:
-        """The caption as reStructuredText, for Snakemake's report."""
-        return f"**{self.title}.** {self.full_caption(profile_ch)}\n"
+        """The caption as reStructuredText, for Snakemake's report: the plain text with every
+        character that reStructuredText reads as markup escaped (|u| would be a substitution)."""
+        return f"**{rst_text(self.title)}.** {rst_text(self.full_caption(profile_ch))}\n"
+
+
+def rst_text(text: str) -> str:
+    """``text`` as literal reStructuredText: backslash before each inline-markup character."""
+    return re.sub(r"([\\`*_|<>\[\]])", r"\\\1", text)
 
 
 def _dp_mm(ds):
