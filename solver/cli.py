@@ -14,8 +14,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", required=True, help="NetCDF file to write")
     r.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
     r.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    c = sub.add_parser("check", help="validate a scene and print its particle count")
-    c.add_argument("scene")
+    c = sub.add_parser("check", help="validate a scene or a conveyor case file and print its particle count")
+    c.add_argument("scene", help="scene YAML file, or a conveyor case file (as for front)")
     f = sub.add_parser("front", help="run the conveyor-belt flow-front case to steady state")
     f.add_argument("case", help="case YAML file (see docs/conveyor.md)")
     f.add_argument("-o", "--output", required=True, help="NetCDF file to write")
@@ -45,8 +45,20 @@ def main(argv=None) -> int:
     try:
         scene = load_scene(args.scene)
     except (SceneError, OSError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        case, case_error = _conveyor_case(args.scene)
+        if case is None:
+            print(f"error: {case_error or exc}", file=sys.stderr)
+            return 2
+        if args.command == "run":
+            print(f"error: {args.scene} is a conveyor case file, not a scene: run it with "
+                  f"python -m solver front {args.scene} -o OUT.nc", file=sys.stderr)
+            return 2
+        from .conveyor import build_scene
+        scene = build_scene(case)
+        print(f"{case.name}: conveyor case (python -m solver front), h_n = {case.h_n * 1e3:.4g} mm, "
+              f"h_n / dp = {case.h_n / case.dp:.3g}, about {scene.estimated_particles()} particles, "
+              f"h = {scene.h:g} m, c0 = {scene.c0:g} m/s")
+        return 0
     if args.command == "check":
         print(f"{scene.name}: about {scene.estimated_particles()} particles, h = {scene.h:g} m, "
               f"c0 = {scene.c0:g} m/s")
@@ -62,6 +74,26 @@ def main(argv=None) -> int:
         msg += f" ({res.reason})"
     print(msg, file=sys.stderr)
     return 0 if res.status == "completed" else 3
+
+
+def _conveyor_case(path):
+    """(the conveyor case the file holds, None) or (None, its error as a case file when it has
+    keys only a case file has, else None: then it is a scene and the scene's error stands)."""
+    import dataclasses
+
+    from .conveyor import ConveyorCase, case_from_dict
+    from .scene import Scene, SceneError, read_yaml
+    try:
+        data = read_yaml(path) or {}
+    except (SceneError, OSError, ValueError):
+        return None, None
+    try:
+        return case_from_dict(data), None
+    except (SceneError, ValueError, TypeError) as exc:
+        case_only = ({f.name for f in dataclasses.fields(ConveyorCase)}
+                     - {f.name for f in dataclasses.fields(Scene)})
+        is_case = isinstance(data, dict) and bool(case_only & set(data))
+        return None, (f"{exc} (read as a conveyor case file)" if is_case else None)
 
 
 def _set_threads(threads) -> bool:

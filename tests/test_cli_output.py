@@ -80,3 +80,21 @@ def test_overrides_rename_a_named_case():
     named = apply_overrides({"name": "a", "dp": 1e-3}, ["shifting=skillen", "name=b"])
     assert named["name"] == "b"  # an explicit name wins
     assert apply_overrides({"name": "a", "dp": 1e-3}, [])["name"] == "a"
+
+
+def test_check_reads_a_conveyor_case_file_and_run_points_to_front(tmp_path, examples_dir):
+    """`check` validates a conveyor case file as such (h_n = 18.76 mm for the paper's fluid at
+    dp = 1 mm: 18.8 particles deep); `run` refuses it naming `front`; a typo in a case file is
+    reported against the case's keys, not the scene's."""
+    from solver.cli import main
+    case = examples_dir / "conveyor_fast.yaml"
+    p = run_cli("check", str(case))
+    assert p.returncode == 0 and "conveyor case" in p.stdout and "h_n = 18.76 mm" in p.stdout, p.stderr
+    assert "h_n / dp = 18.8" in p.stdout
+    out = tmp_path / "x.nc"
+    assert main(["run", str(case), "-o", str(out)]) == 2 and not out.exists()
+    typo = tmp_path / "typo.yaml"
+    typo.write_text(case.read_text().replace("slope_deg", "slope_degs"))
+    p = run_cli("check", str(typo))
+    assert p.returncode == 2 and "case: unknown key(s) slope_degs" in p.stderr
+    assert "read as a conveyor case file" in p.stderr
