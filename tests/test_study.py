@@ -369,7 +369,8 @@ def dry_run(configfile, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18), ("accuracy.yaml", 16)])
+@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18), ("accuracy.yaml", 16),
+                                     ("stability.yaml", 22), ("viscoplastic.yaml", 6)])
 def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     counts = dry_run(ROOT / "config" / name, tmp_path)
     assert counts["run_case"] == n and counts["metrics"] == n and counts["case_file"] == n
