@@ -458,6 +458,17 @@ def test_compare_campaigns_measures_changes_in_combined_standard_errors():
     assert (z > 2).sum() == 1 and z.size == (new.sizes["case"] - 1) * (3 + new.sizes["station"])
 
 
+def test_a_grid_point_takes_the_status_of_its_worst_realisation():
+    from study.campaign import worst_member
+
+    def run(status):
+        return xr.Dataset(attrs={"status": status, "reason": ""})
+    members = [(k, run(s)) for k, s in enumerate(["completed", "not_steady", "diverged", "diverged"])]
+    assert worst_member(members)[0] == 2  # diverged outranks not steady; the first of them
+    assert worst_member(members[:2])[0] == 1
+    assert worst_member(members[:1])[0] == 0 and worst_member([members[0], (5, run("completed"))])[0] == 0
+
+
 def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
     """Realisation 0 is the case as configured (the same solver file as without an ensemble,
     so its finished run is kept); realisation k moves the start by the configured amplitude

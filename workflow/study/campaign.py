@@ -88,6 +88,15 @@ def ensemble_mean(values: np.ndarray, errors: np.ndarray | None = None) -> tuple
     return mean.reshape(shape), se.reshape(shape)
 
 
+def worst_member(members: list[tuple]) -> tuple:
+    """The (case, run) whose status a grid point takes: the first diverged realisation, else the
+    first that did not complete, else realisation 0 (members in realisation order)."""
+    def rank(member):
+        status = member[1].attrs["status"]
+        return 0 if status == "diverged" else 1 if status != "completed" else 2
+    return min(members, key=rank)  # min keeps the first of equal rank
+
+
 def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
           front_particles: int = 4000) -> xr.Dataset:
     """The campaign dataset from each case's run and metrics datasets (same order)."""
@@ -148,10 +157,10 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
             (data["front_x"][ix], data["front_z"][ix], data["front_speed"][ix],
              data["front_yielded"][ix]) = _front_particles(run, front_particles)
         # the grid point counts as completed and steady only if every realisation is
-        worst = next(((cc, r) for cc, r, _ in members if r.attrs["status"] != "completed"), (c, run))
-        status[ix], reason[ix], case_ids[ix] = worst[1].attrs["status"], worst[1].attrs["reason"], c.id
-        if worst[0] is not c and reason[ix]:
-            reason[ix] = f"{worst[0].id}: {reason[ix]}"
+        worst_case, worst_run = worst_member([(cc, r) for cc, r, _ in members])
+        status[ix], reason[ix], case_ids[ix] = worst_run.attrs["status"], worst_run.attrs["reason"], c.id
+        if worst_case is not c and reason[ix]:
+            reason[ix] = f"{worst_case.id}: {reason[ix]}"
         steady[ix] = min(float(mm["steady"]) for _, _, mm in members)
 
     dims = ("dp", "ch", "shifting")
