@@ -1,6 +1,6 @@
 """A miniature campaign end to end: Snakemake -> per-case NetCDF -> campaign.nc -> report.
 
-Two very coarse, short grid cases in two realisations each, and one extra case forced to
+Two very coarse, short grid cases, the finer in two realisations, and one extra case forced to
 diverge (cfl = 5), which must be shown as such while the campaign completes. Then: changing a
 figure setting reruns no simulation.
 """
@@ -48,14 +48,18 @@ def test_campaign_dataset(campaign):
     on_grid = ds.sel(ch=1.5, shifting="skillen")
     assert np.all(on_grid["status"].values == "completed")
     assert np.all(np.isfinite(on_grid["zeta_h"].values))
-    # two realisations a grid point: the perturbed start gives another run, and the grid
-    # point holds their mean
-    assert ds["realisations"].values.ravel().tolist() == [2, 2] and ds.attrs["realisations"] == 2
-    for dp in ("4", "3.5"):
-        a, b = (list(ds["case"].values).index(f"dp{dp}mm_ch1.5_skillen{r}") for r in ("", "_r1"))
-        pair = ds["case_zeta_fs"].values[[a, b]]
-        assert pair[0] != pair[1]
-        assert float(on_grid["zeta_fs"].sel(dp=float(dp) / 1000)) == pytest.approx(pair.mean(), rel=1e-12)
+    # dp = 3.5 mm in two realisations: the perturbed start gives another run, and the grid
+    # point holds their mean; dp = 4 mm ran once (ensemble.overrides) and holds its run's value
+    assert ds["realisations"].values.ravel().tolist() == [1, 2] and ds.attrs["realisations"] == 2
+    cases = list(ds["case"].values)
+    assert "dp4mm_ch1.5_skillen_r1" not in cases
+    a, b = (cases.index(f"dp3.5mm_ch1.5_skillen{r}") for r in ("", "_r1"))
+    pair = ds["case_zeta_fs"].values[[a, b]]
+    assert pair[0] != pair[1]
+    assert float(on_grid["zeta_fs"].sel(dp=0.0035)) == pytest.approx(pair.mean(), rel=1e-12)
+    single = cases.index("dp4mm_ch1.5_skillen")
+    assert float(on_grid["zeta_fs"].sel(dp=0.004)) == float(ds["case_zeta_fs"].values[single])
+    assert float(on_grid["zeta_fs_se"].sel(dp=0.004)) == float(ds["case_zeta_fs_se"].values[single])
 
 
 def test_report_has_every_section(campaign):
@@ -69,6 +73,8 @@ def test_report_has_every_section(campaign):
     # the forced divergence is counted and named in the stability section and map
     assert "1 diverged, 1 of them stopped by a named detector (1 density deviation)" in html
     assert "http://" not in html and "https://" not in html  # opens offline
+    assert ("grid points ran in 2 realisations: dp3.5mm_ch1.5_skillen; in 1 realisation: "
+            "dp4mm_ch1.5_skillen") in html
 
 
 def test_report_in_a_real_browser(campaign):

@@ -99,6 +99,23 @@ def test_an_ensemble_campaign_says_what_its_grid_values_and_errors_are():
     ds["realisations"] = xr.full_like(ds["wall_time"], 3, dtype=int)
     ds.attrs.update(realisations=3, start_perturbation=1e-6)
     text = render(ds, [], "grid: {}")
-    assert "every grid case ran in 3 realisations" in text and "moved by up to 1e-06 dp" in text
-    assert f"{ds.sizes['case']} cases (every grid case in 3 realisations: {ds['wall_time'].size} grid points)" in text
+    assert "every grid case ran in 3 realisations" in text and "start by up to 1e-06 dp" in text
+    n_points = ds["wall_time"].size
+    assert f"{ds.sizes['case']} cases ({n_points} grid points; every grid case ran in 3 realisations)" in text
     assert "cheapest steady grid point &le; 0.01" in text
+
+
+def test_an_ensemble_of_different_sizes_names_its_grid_points_by_count():
+    """With ensemble.overrides, grid points ran in different numbers of realisations: the report
+    lists them by count, most first; an ensemble of one realisation a point says nothing."""
+    ds = campaign(paper_like)
+    ds["realisations"] = xr.full_like(ds["wall_time"], 1, dtype=int)
+    finest = ds["dp"].values.min()
+    ds["realisations"].loc[dict(dp=finest)] = 4
+    ds.attrs.update(start_perturbation=1e-3)
+    text = render(ds, [], "grid: {}")
+    four = [str(c) for c in ds["case_id"].sel(dp=finest).values.ravel()]
+    rest = [str(c) for c in ds["case_id"].values.ravel() if str(c) not in four]
+    assert "grid points ran in 4 realisations: " + ", ".join(four) + "; in 1 realisation: " + ", ".join(rest) in text
+    ds["realisations"][:] = 1
+    assert "Ensemble:" not in render(ds, [], "grid: {}")

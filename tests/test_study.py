@@ -145,7 +145,7 @@ def test_command_line_strings_read_as_the_schema_types():
     c = load("config.yaml")
     c.update(ensemble={"realisations": "4", "perturbation": "1e-3"}, figures={"dpi": "90"})
     cfg = cfgmod.validate(c)
-    assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001}
+    assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001, "overrides": []}
     assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40
     schema = cfgmod.load_schema()
     assert cfgmod.coerce_scalars({"warm_start": "True"}, schema) == {"warm_start": True}
@@ -489,7 +489,31 @@ def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
     assert (d["start_perturbation"], d["perturbation_seed"]) == (1.0e-5, 2)
     assert "start_perturbation" not in case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])
     assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_r1"]).id == "dp3mm_ch1.5_lind_r1"
-    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-3}
+    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-3, "overrides": []}
+
+
+def test_ensemble_overrides_set_the_realisations_of_some_grid_points():
+    """ensemble.overrides: the last matching entry sets a grid point's count (dp compared as a
+    float); extra cases still run once; a warm start takes the coarser point's same
+    realisation, or its realisation 0 where that point ran fewer; a bad entry is named."""
+    from study.config import ConfigError, cases, validate, warm_source
+    base = {"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind", "skillen"]},
+            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}], "warm_start": True}
+    cfg = validate({**base, "ensemble": {"realisations": 2, "overrides": [
+        {"where": {"dp": "2e-3"}, "realisations": 3},
+        {"where": {"dp": 0.002, "shifting": "skillen"}, "realisations": 1}]}})
+    ids = [c.id for c in cases(cfg)]
+    assert ids == ["dp3mm_ch1.5_lind", "dp3mm_ch1.5_lind_r1", "dp3mm_ch1.5_skillen", "dp3mm_ch1.5_skillen_r1",
+                   "dp2mm_ch1.5_lind", "dp2mm_ch1.5_lind_r1", "dp2mm_ch1.5_lind_r2",
+                   "dp2mm_ch1.5_skillen", "dp2mm_ch1.5_lind_x"]
+    by_id = {c.id: c for c in cases(cfg)}
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_r1"]).id == "dp3mm_ch1.5_lind_r1"
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_r2"]).id == "dp3mm_ch1.5_lind"
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_skillen"]).id == "dp3mm_ch1.5_skillen"
+    with pytest.raises(ConfigError, match=r"ensemble\.overrides\.0.*realisations"):
+        validate({**base, "ensemble": {"overrides": [{"where": {"dp": 0.002}}]}})
+    with pytest.raises(ConfigError, match=r"ensemble\.overrides\.0\.where.*'lind'"):
+        validate({**base, "ensemble": {"overrides": [{"where": {"shifting": "Lind"}, "realisations": 2}]}})
 
 
 def test_the_ensemble_mean_and_its_error():

@@ -52,7 +52,9 @@ def _front_particles(run: xr.Dataset, max_n: int):
 
 
 def ensemble_size(ds: xr.Dataset) -> int:
-    """Realisations each grid point of a campaign dataset averages (1: no ensemble)."""
+    """The most realisations a grid point of a campaign dataset averages (1: no ensemble)."""
+    if "realisations" in ds:
+        return max(int(ds["realisations"].max()), 1)
     return int(ds.attrs.get("realisations", 1))
 
 

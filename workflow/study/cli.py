@@ -75,7 +75,7 @@ def cmd_reduce(a):
                     normalising_depth_m=float(cfg["reference"]["normalising_depth"]),
                     slope_deg=float(solver_case(cfg).slope_deg),
                     config_yaml=yaml.safe_dump(cfg, sort_keys=False),
-                    realisations=int(cfg["ensemble"]["realisations"]),
+                    realisations=int(ds["realisations"].max()),
                     start_perturbation=float(cfg["ensemble"]["perturbation"]),
                     version_numba=str(runs[0].attrs.get("version_numba", "")))
     write_atomic(ds, a.output)

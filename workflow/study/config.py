@@ -102,7 +102,7 @@ def validate(config: dict) -> dict:
     if errors:  # every problem at once, each naming its key
         raise ConfigError("; ".join(f"config key {_path(e)}: {_message(e)}" for e in errors))
     try:
-        cases = expand(cfg["grid"], cfg.get("extra_cases"), realisations(cfg))
+        cases = expand(cfg["grid"], cfg.get("extra_cases"), lambda *point: realisations(cfg, *point))
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     if not cases:
@@ -125,12 +125,18 @@ def load(path) -> dict:
 
 
 def cases(cfg: dict) -> list[Case]:
-    return expand(cfg["grid"], cfg.get("extra_cases"), realisations(cfg))
+    return expand(cfg["grid"], cfg.get("extra_cases"), lambda *point: realisations(cfg, *point))
 
 
-def realisations(cfg: dict) -> int:
-    """Realisations of each grid case (``ensemble.realisations``; 1 where the key is absent)."""
-    return int((cfg.get("ensemble") or {}).get("realisations", 1))
+def realisations(cfg: dict, dp: float, ch: float, shifting: str) -> int:
+    """Realisations of the grid case (dp, ch, shifting): ``ensemble.realisations`` (1 where the
+    key is absent), or that of the last ``ensemble.overrides`` entry whose ``where`` it matches."""
+    ensemble = cfg.get("ensemble") or {}
+    n = ensemble.get("realisations", 1)
+    for entry in ensemble.get("overrides") or []:
+        if matches(entry["where"], dp, ch, shifting):
+            n = entry["realisations"]
+    return int(n)
 
 
 def _merge(base: dict, changes: dict) -> dict:
@@ -144,13 +150,18 @@ def _merge(base: dict, changes: dict) -> dict:
 
 
 def warm_source(cfg: dict, case: Case) -> Case | None:
-    """With ``warm_start``: the grid case at the next coarser dp with the same Ch, shifting
-    and realisation, whose final state starts this one; None for the coarsest and extra cases."""
+    """With ``warm_start``: the grid case at the next coarser dp with the same Ch and shifting,
+    whose final state starts this one: its same realisation, or its realisation 0 where that
+    grid point ran fewer; None for the coarsest and extra cases."""
     if not cfg.get("warm_start") or not case.on_grid:
         return None
     coarser = [c for c in cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
-               and c.realisation == case.realisation and c.dp > case.dp]
-    return min(coarser, key=lambda c: c.dp) if coarser else None
+               and c.dp > case.dp]
+    if not coarser:
+        return None
+    dp = min(c.dp for c in coarser)
+    point = {c.realisation: c for c in coarser if c.dp == dp}
+    return point.get(case.realisation, point[0])
 
 
 def run_path(case: Case) -> str:

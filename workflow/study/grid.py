@@ -1,6 +1,7 @@
 """Case grid: dp x Ch x shifting from the config, with canonical, float-safe case ids."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 CASE_ID = r"dp[0-9]+(?:\.[0-9]+)?mm_ch[0-9]+(?:\.[0-9]+)?_(?:none|skillen|lind)(?:_[a-z0-9-]+)?"
@@ -46,10 +47,13 @@ def matches(selector: dict, dp: float, ch: float, shifting: str) -> bool:
     return all(values[k] == (v if k == "shifting" else float(v)) for k, v in selector.items())
 
 
-def expand(grid: dict, extra: list[dict] | None = None, realisations: int = 1) -> list[Case]:
+def expand(grid: dict, extra: list[dict] | None = None,
+           realisations: int | Callable[[float, float, str], int] = 1) -> list[Case]:
     """Cases of the grid (``combine``: product, or paper = every Ch with the first shifting
     method plus every method at ``paper_ch``), less those matching an ``exclude`` entry, each
-    in ``realisations`` realisations (0, 1, ...), followed by the extra cases; ids unique."""
+    in ``realisations`` realisations (0, 1, ...; a number, or a function of dp, ch and
+    shifting), followed by the extra cases; ids unique."""
+    count = realisations if callable(realisations) else (lambda dp, ch, sh: int(realisations))
     dps, chs, shifts = grid["dp"], grid["ch"], grid["shifting"]
     combine = grid.get("combine", "product")
     excluded = grid.get("exclude") or []
@@ -65,7 +69,8 @@ def expand(grid: dict, extra: list[dict] | None = None, realisations: int = 1) -
                     continue
                 if left_out(float(dp), float(ch), sh):
                     continue
-                cases.extend(Case(float(dp), float(ch), sh, realisation=k) for k in range(realisations))
+                n = count(float(dp), float(ch), sh)
+                cases.extend(Case(float(dp), float(ch), sh, realisation=k) for k in range(n))
     for e in extra or []:
         cases.append(Case(float(e["dp"]), float(e["ch"]), e["shifting"], e.get("tag"),
                           dict(e.get("overrides") or {})))

@@ -233,19 +233,34 @@ def stability_section(ds: xr.Dataset) -> str:
     return text
 
 
+def ensemble_counts(ds: xr.Dataset) -> str:
+    """How many realisations the grid points ran: 'every grid case ran in 4 realisations', or
+    per count, 'grid points ran in 8 realisations: dp1mm_ch1.8_lind, ...; in 1 realisation:
+    ...' (most first)."""
+    grid = ds["realisations"].stack(point=("dp", "ch", "shifting"))
+    ran = grid.values > 0
+    counts = grid.values[ran]
+    names = ds["case_id"].stack(point=("dp", "ch", "shifting")).values[ran]
+    sizes = sorted(set(counts.tolist()), reverse=True)
+    if len(sizes) == 1:
+        return f"every grid case ran in {sizes[0]} realisations"
+    return "grid points ran in " + "; in ".join(
+        f"{n} realisation{'s' if n > 1 else ''}: " + ", ".join(html.escape(str(c)) for c in names[counts == n])
+        for n in sizes)
+
+
 def ensemble_paragraph(ds: xr.Dataset) -> str:
     """What a grid point's value and se are when the campaign ran an ensemble; empty without."""
-    n = ensemble_size(ds)
-    if n <= 1:
+    if ensemble_size(ds) <= 1:
         return ""
     amp = float(ds.attrs.get("start_perturbation", np.nan))
-    return (f"<p><b>Ensemble:</b> every grid case ran in {n} realisations, the case as configured and "
-            f"{n - 1} with each fluid particle's start moved by up to {amp:g} dp (ids ending in _r1, "
+    return (f"<p><b>Ensemble:</b> {ensemble_counts(ds)}. Realisation 0 is the case as configured, "
+            f"the others move each fluid particle's start by up to {amp:g} dp (ids ending in _r1, "
             "_r2, ...; all in the case table). A grid point's metrics are the means over its "
-            "realisations, and its se is sqrt(max(s<sup>2</sup>, mean se<sub>i</sub><sup>2</sup>) / n): "
-            "s, the realisations' spread, holds what one window's se misses; the windows' own se "
-            "bound it from below. A grid point counts as completed and steady only if every "
-            "realisation is. Its wall time is a realisation's mean.</p>")
+            "n realisations, and its se is sqrt(max(s<sup>2</sup>, mean se<sub>i</sub><sup>2</sup>) / n) "
+            "(a single run's: its window's se): s, the realisations' spread, holds what one "
+            "window's se misses; the windows' own se bound it from below. A grid point counts as "
+            "completed and steady only if every realisation is. Its wall time is a realisation's mean.</p>")
 
 
 def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: str,
@@ -308,9 +323,8 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     question = ("Does this campaign reproduce the conclusions of Lapillonne et al. (SPHERIC 2022)?"
                 if newtonian else f"A {html.escape(ds.attrs['rheology'])} fluid: how close are its fronts to "
                 "the lubrication reference, and at what cost?")
-    n_real = ensemble_size(ds)
-    ensemble = "" if n_real <= 1 else (
-        f" (every grid case in {n_real} realisations: {int(np.sum(ds['realisations'].values > 0))} grid points)")
+    ensemble = "" if ensemble_size(ds) <= 1 else (
+        f" ({int(np.sum(ds['realisations'].values > 0))} grid points; {ensemble_counts(ds)})")
     lead = (f"<p class='lead'>{n} cases{ensemble}, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
             f"{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
