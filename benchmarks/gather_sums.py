@@ -315,15 +315,15 @@ def case_state(case_file: Path, overrides: list[str], sim_time: float) -> Simula
 def measure(sim: Simulation, calls: int) -> dict:
     s = sim
     o = s.pair_options
-    if not gather_applies(s.mdbc, s.implicit, s.variable_viscosity, o["artificial"], o["column_reference"],
-                          s.diffusion, s.constants.k_hyd, s.h):
+    if o["viscous_scale"] or not gather_applies(s.mdbc, s.implicit, s.variable_viscosity, o["artificial"],
+                                                 o["column_reference"], s.diffusion, s.constants.k_hyd, s.h):
         raise SystemExit(f"the gather does not apply to this scheme: {o}")
     loop = make_gather_loop(s.diffusion, o["shifting"], o["shift_correction"], o["column_reference"],
                             o["viscous_correction"], o["volume"])
     g = s.scene.gravity
     forces.pressure_and_inverse_density(s.rho, s.p, s.irho, s.B, s.rho0)
     fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
-                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho)
+                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho, s.viscous_scale)
     acc = np.zeros((s.nthreads, s.n, s.nq))
     out = np.zeros((s.nq, s.n))
     vmax = np.zeros(s.nthreads)

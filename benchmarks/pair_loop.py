@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import inspect
 import json
 import shutil
 import sys
@@ -53,9 +54,12 @@ def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, parti
     options = s.pair_options
     forces.pressure_and_inverse_density(s.rho, s.p, s.irho, s.B, s.rho0)
     fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
-                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho)
+                               s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho, s.viscous_scale)
     old_fields = old_forces.PairFields(*fields[:len(old_forces.PairFields._fields)])
-    loops = [(old_forces.make_pair_loop(**options), old_fields),
+    known = inspect.signature(old_forces.make_pair_loop).parameters  # an older tree's switches
+    if any(v for k, v in options.items() if k not in known):
+        raise SystemExit(f"the old tree's pair loop has no switch for {[k for k in options if k not in known]}")
+    loops = [(old_forces.make_pair_loop(**{k: v for k, v in options.items() if k in known}), old_fields),
              (forces.make_pair_loop(**options), fields)]
 
     def call(k):

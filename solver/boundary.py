@@ -123,6 +123,8 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
             b0 = b1 = b2 = 0.0
             su = sw = 0.0
             bu1 = bu2 = bw1 = bw2 = 0.0
+            umin = wmin = math.inf
+            umax = wmax = -math.inf
             for ddx in range(-1, 2):
                 jx, shift = neighbour_column(cl, ix, ddx)
                 if jx < 0:
@@ -161,6 +163,8 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
                     su += u[j] * WV
                     sw += w[j] * WV
                     if corrected_velocity:
+                        umin, umax = min(umin, u[j]), max(umax, u[j])
+                        wmin, wmax = min(wmin, w[j]), max(wmax, w[j])
                         bu1 += u[j] * gxv * h
                         bu2 += u[j] * gzv * h
                         bw1 += w[j] * gxv * h
@@ -185,8 +189,12 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
             else:
                 rb = b0 / a00
             if corrected_velocity and well_posed:
-                ug = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0]
-                wg = _cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0]
+                # within the range of the fluid velocities it interpolates: no overshoot where
+                # the ghost's support is cut by a free surface as well as by the wall
+                ug = min(max(_cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0],
+                             umin), umax)
+                wg = min(max(_cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0],
+                             wmin), wmax)
             else:
                 ug = su / a00
                 wg = sw / a00

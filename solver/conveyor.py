@@ -112,6 +112,7 @@ class ConveyorCase(YamlData):
     density_diffusion: float | None = 0.1
     density_diffusion_reference: str = "spec"
     viscous_correction: bool = False
+    viscous_normalisation: bool = False
     volume_relaxation: float | None = None
     viscous_update: str = "explicit"  # implicit or substepped: no viscous limit on dt; auto(_substepped): where it pays
     density_update: str = "explicit"  # leapfrog: the density's second half step at v^{n+1}
@@ -374,6 +375,7 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
                     "density_diffusion": c.density_diffusion,
                     "density_diffusion_reference": c.density_diffusion_reference,
                     "viscous_correction": c.viscous_correction,
+                    "viscous_normalisation": c.viscous_normalisation,
                     "volume_relaxation": c.volume_relaxation,
                     "viscous_update": c.viscous_update, "density_update": c.density_update,
                     "no_tension": c.no_tension, "shifting": shifting},

@@ -54,15 +54,15 @@ NQ_BASE, NQ_SHIFT, NQ_CORRECTED, NQ_VISCOUS = 3, 8, 9, 16
 # corrected strain rate: the Laplacian of the last strain rate, and the support sum_b V_b (-F r^2) / 2
 LAPG, SUPP, NQ_STRAIN = 16, 17, 18
 # volume relaxation: the concentration sum_b V_b W_ab (without the self term) in the slot after
-# the others (``volume_slot``); implicit viscosity: the diagonal sum_b c_ab of the backward-Euler
-# system in the last slot
+# the others (``volume_slot``); the laminar term's normaliser N (viscous_scale) in the slot after
+# that; implicit viscosity: the diagonal sum_b c_ab of the backward-Euler system in the last slot
 
 
 def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
             velocity_gradient: bool = False, implicit: bool = False,
-            strain_correction: bool = False, volume: bool = False) -> int:
+            strain_correction: bool = False, volume: bool = False, viscous_scale: bool = False) -> int:
     nq = volume_slot(shifting, shift_correction, viscous_correction, velocity_gradient,
-                     strain_correction) + (1 if volume else 0)
+                     strain_correction) + (1 if volume else 0) + (1 if viscous_scale else 0)
     return nq + 1 if implicit else nq
 
 
@@ -145,6 +145,7 @@ class PairFields(NamedTuple):
     gamma: np.ndarray  # each particle's last strain rate (read with strain_correction only)
     cell: np.ndarray  # lattice cell dp dz of each particle (read with shifting only)
     irho: np.ndarray  # 1 / rho of each particle (``pressure_and_inverse_density``)
+    vscale: np.ndarray  # each particle's laminar-term factor (read with viscous_scale only)
 
 
 class PairConstants(NamedTuple):
@@ -253,7 +254,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                    column_reference: bool = False, viscous_correction: bool = False,
                    artificial: bool = False, variable_viscosity: bool = False,
                    implicit_walls: float = 0.0, strain_correction: bool = False,
-                   volume: bool = False):
+                   volume: bool = False, viscous_scale: bool = False):
     """Compile the pair loop with density diffusion, the shifting sums and the shift's
     divergence (for the density correction) in or out; ``column_reference`` picks the
     diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
@@ -267,12 +268,17 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     pairs, the Laplacian 2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate
     g = ``f.gamma`` into LAPG and the support sum_b V_b (-F r^2) / 2 into SUPP (1 with a full
     kernel, ``rheology.update_viscosity``). ``volume`` sums the concentration sum_b V_b W_ab
-    (every pair with a fluid particle) into slot ``volume_slot(...)``, for ``relax_density``."""
+    (every pair with a fluid particle) into slot ``volume_slot(...)``, for ``relax_density``.
+    ``viscous_scale`` multiplies each pair's laminar term by the mean of its two particles'
+    factors ``f.vscale`` (a fluid-wall pair by the fluid particle's) and sums the normaliser
+    N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)) into the slot after the volume's, for
+    ``viscous_scale_factors``."""
     velocity_gradient = viscous_correction or variable_viscosity or strain_correction
     implicit = implicit_walls > 0.0
     VOLC = volume_slot(shifting, shift_correction, viscous_correction, variable_viscosity,
                        strain_correction)
-    DIAG = VOLC + 1 if volume else VOLC
+    NORM = VOLC + 1 if volume else VOLC
+    DIAG = NORM + 1 if viscous_scale else NORM
 
     @nb.njit(cache=True, fastmath=FASTMATH)
     def thread_pairs(t, f, cl, split, k, acc, pair_i, pair_j, pair_k):
@@ -330,6 +336,10 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                     s_diag = 0.0
                     s_lapg = s_supp = 0.0
                     s_volc = 0.0
+                    s_norm = 0.0
+                    sca = 1.0
+                    if viscous_scale:
+                        sca = f.vscale[a]
                     sxa = sza = 0.0
                     if shift_correction:
                         sxa, sza = f.sdx[a], f.sdz[a]
@@ -375,6 +385,16 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                                 vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
                             else:
                                 vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
+                            if viscous_scale:
+                                if kb == 1:
+                                    vt *= sca
+                                elif ka == 1:
+                                    vt *= f.vscale[b]
+                                else:
+                                    vt *= 0.5 * (sca + f.vscale[b])
+                                e = -0.5 * rdotg * r2 * inv_r2e
+                                s_norm += Vb * e
+                                at[b, NORM] += Va * e
                             if artificial:
                                 pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
                             fx = -pt * dx + vt * du
@@ -477,6 +497,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                         at[a, VDIVR] += s_vdivr
                     if volume:
                         at[a, VOLC] += s_volc
+                    if viscous_scale:
+                        at[a, NORM] += s_norm
                     if implicit:
                         at[a, DIAG] += s_diag
                     if strain_correction:
@@ -490,7 +512,7 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         return vm, npl
 
     switches = (diffusion, shifting, shift_correction, column_reference, viscous_correction,
-                artificial, variable_viscosity, implicit_walls, strain_correction, volume)
+                artificial, variable_viscosity, implicit_walls, strain_correction, volume, viscous_scale)
 
     def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
         """acc[t, i, :] = the pair sums of the particles thread t writes (``PairFields`` f,
@@ -637,7 +659,7 @@ VISCOUS_CORRECTION_MIN_DIVR = 1.9  # div r (m/rho volumes) of a particle with (n
 
 
 @nb.njit(parallel=True, cache=True)
-def correct_viscous_term(out, kind, nu, n):
+def correct_viscous_term(out, kind, nu, n, scale, normalised):
     """Remove the first-order error of the laminar term where the kernel support is full.
 
     By Taylor expansion the term sum_b 2 nu V_b F_ab u_ab approximates
@@ -646,14 +668,32 @@ def correct_viscous_term(out, kind, nu, n):
     makes the term too weak (13 % in the body of the paper case at dp = 1 mm with skillen,
     benchmarks/viscous_operator.py). For fluid particles with div r >= 1.9 (away from the free
     surface, where G measures the missing neighbours rather than disorder) subtract
-    2 nu G . grad u, grad u = sum_b V_b (u_b - u_a) gradW_ab. Applied after the reduction:
-    the force limit dt1 of the step uses max |a| before this correction."""
+    2 nu G . grad u, grad u = sum_b V_b (u_b - u_a) gradW_ab. ``normalised``: times the
+    particle's laminar factor ``scale[i]``, as the pair loop scaled the term itself. Applied
+    after the reduction: the force limit dt1 of the step uses max |a| before this correction."""
     for i in nb.prange(n):
         if kind[i] != 0 or out[VDIVR, i] < VISCOUS_CORRECTION_MIN_DIVR:
             continue
         gx, gz = out[VGX, i], out[VGZ, i]
-        out[AX, i] -= 2.0 * nu * (gx * out[DUX, i] + gz * out[DUZ, i])
-        out[AZ, i] -= 2.0 * nu * (gx * out[DWX, i] + gz * out[DWZ, i])
+        c = 2.0 * nu * (scale[i] if normalised else 1.0)
+        out[AX, i] -= c * (gx * out[DUX, i] + gz * out[DUZ, i])
+        out[AZ, i] -= c * (gx * out[DWX, i] + gz * out[DWZ, i])
+
+
+@nb.njit(parallel=True, cache=True)
+def viscous_scale_factors(out, kind, n, norm_slot, scale):
+    """The laminar term's normalisation for the next evaluation: scale = 1 / N for fluid
+    particles with div r >= 1.9 (m/rho volumes), 1 elsewhere, N = out[norm_slot].
+
+    By Taylor expansion the corrected term is nu sum_b V_b (-F) r^2 / (r^2 + eta^2)
+    (r_ab . grad grad u . r_ab): for the isotropic u = |r|^2 / 4 (laplacian 1) it gives nu N, N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)), which a continuous kernel without
+    eta makes 1. On a square lattice at Ch 1.8, N = 0.982 (0.995 from div r / 2, the rest
+    from eta), and so is the film's response nu u''. Dividing by N removes the isotropic part
+    of that error. Near the free surface (div r < 1.9) the support is cut and the term is left
+    as it is."""
+    for i in nb.prange(n):
+        ok = kind[i] == 0 and out[VDIVR, i] >= VISCOUS_CORRECTION_MIN_DIVR
+        scale[i] = 1.0 / out[norm_slot, i] if ok else 1.0
 
 
 @nb.njit(inline="always", cache=True)

@@ -74,6 +74,9 @@ class Simulation:
         shifting_on = self.shift_method != "none"
         self.correct_shift = shifting_on and s.shift_density_correction
         self.viscous_correction = bool(s.physics.viscous_correction)
+        self.viscous_normalisation = bool(s.physics.viscous_normalisation)
+        # each particle's laminar factor, from the last evaluation (viscous_normalisation)
+        self.viscous_scale = np.ones(self.n if self.viscous_normalisation else 1)
         self.variable_viscosity = not s.fluid.newtonian
         self.strain_correction = self.variable_viscosity and bool(s.fluid.strain_rate_correction)
         # the last strain rate (strain_rate_correction; a placeholder otherwise)
@@ -88,7 +91,11 @@ class Simulation:
         self.cfl_acoustic = s.cfl_acoustic  # C of the acoustic limit (cfl_rule)
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
                                  self.variable_viscosity, self.implicit, self.strain_correction,
-                                 self.volume_relaxation > 0)
+                                 self.volume_relaxation > 0, self.viscous_normalisation)
+        # the laminar normaliser's slot: after the volume's (``forces.make_pair_loop``)
+        self.norm_slot = forces.volume_slot(shifting_on, self.correct_shift, self.viscous_correction,
+                                            self.variable_viscosity, self.strain_correction) + \
+            (1 if self.volume_relaxation > 0 else 0)
         # the pair loop's compile-time switches (``forces.make_pair_loop``)
         self.pair_options = dict(
             diffusion=self.diffusion, shifting=shifting_on, shift_correction=self.correct_shift,
@@ -96,12 +103,14 @@ class Simulation:
             viscous_correction=self.viscous_correction, artificial=bool(s.physics.artificial_viscosity),
             variable_viscosity=self.variable_viscosity,
             implicit_walls=(2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
-            strain_correction=self.strain_correction, volume=self.volume_relaxation > 0)
+            strain_correction=self.strain_correction, volume=self.volume_relaxation > 0,
+            viscous_scale=self.viscous_normalisation)
         self.pair_loop = forces.make_pair_loop(**self.pair_options)
         self.substeps = s.viscous_substeps  # RKC stages rather than CG (no CG start to carry)
         self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
+                              + (("viscous_scale",) if self.viscous_normalisation else ())
                               + (_IMPLICIT if self.implicit and not self.substeps else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
         self.rkc_stages = 0  # stages of the sub-stepped viscous updates, summed
@@ -199,7 +208,7 @@ class Simulation:
         forces.pressure_and_inverse_density(self.rho, self.p, self.irho, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
-                                   self.gamma_p, self.cell_volume, self.irho)
+                                   self.gamma_p, self.cell_volume, self.irho, self.viscous_scale)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
             # more pairs than the list holds: widen it and evaluate again
@@ -210,7 +219,11 @@ class Simulation:
                                                s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
         if self.viscous_correction:
-            forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active)
+            forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active, self.viscous_scale,
+                                        self.viscous_normalisation)
+            if self.viscous_normalisation:  # the factors of the next evaluation
+                forces.viscous_scale_factors(self.out, self.kind, self.n_active, self.norm_slot,
+                                             self.viscous_scale)
         if self.variable_viscosity:  # the viscosity of the next evaluation
             fl = s.fluid
             self.nu_max_now = rheology.update_viscosity(
@@ -396,8 +409,8 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFT + _IMPLICIT + ("nu_p", "gamma_p", "nu_max_now", "t", "steps", "info", "dt_first",
-                                             "n_active", "reason")
+    _STATE = _SORTED + _SHIFT + _IMPLICIT + ("nu_p", "gamma_p", "viscous_scale", "nu_max_now", "t", "steps",
+                                             "info", "dt_first", "n_active", "reason")
 
     def state(self) -> dict:
         """Everything needed to resume exactly where this simulation stands."""
