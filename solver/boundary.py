@@ -9,7 +9,10 @@ when that is not below rho_g (the wall is never weaker than the fluid at its gho
 and floored at rho0 (a wall pushes, never pulls: near a free surface the interpolation
 would otherwise give wall tension that draws fluid into the wall);
 no-slip velocity v_b = 2 v_wall - v_g with v_g the Shepard-interpolated fluid velocity
-(or, as an option, interpolated with the same first-order correction as the density).
+(or, as an option, interpolated with the same first-order correction as the density, limited
+to the range of the fluid velocities it interpolates and faded to Shepard's value where the
+ghost's support is lopsided along the wall: its first moment along the wall, over the Shepard
+sum, from 0 to TANGENTIAL_MOMENT_MAX h, as where a free surface meets the wall).
 """
 from __future__ import annotations
 
@@ -24,6 +27,7 @@ from .forces import FASTMATH
 from .kernel import alpha_2d, grad_coefficient, grad_factor, kernel, w_value
 
 DET_MIN = 1.0e-3  # on the matrix made dimensionless with h
+TANGENTIAL_MOMENT_MAX = 0.1  # h: the corrected ghost velocity fades out up to this lopsidedness
 
 
 def wall_velocities(walls, t: float) -> np.ndarray:
@@ -188,16 +192,24 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
                 rb = max(rg + (ddxg * gdx + (z[i] - gz) * gdz) / h, rg)
             else:
                 rb = b0 / a00
+            ug = su / a00
+            wg = sw / a00
             if corrected_velocity and well_posed:
                 # within the range of the fluid velocities it interpolates: no overshoot where
                 # the ghost's support is cut by a free surface as well as by the wall
-                ug = min(max(_cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0],
+                uc = min(max(_cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, su, bu1, bu2)[0],
                              umin), umax)
-                wg = min(max(_cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0],
+                wc = min(max(_cramer(a00, a01, a02, a10, a11, a12, a20, a21, a22, det, sw, bw1, bw2)[0],
                              wmin), wmax)
-            else:
-                ug = su / a00
-                wg = sw / a00
+                # faded towards Shepard where the support is lopsided along the wall
+                nx, nz = gx - x[i], gz - z[i]
+                nn = math.sqrt(nx * nx + nz * nz)
+                fade = 1.0
+                if nn > 0.0:
+                    mt = abs(a01 * nz - a02 * nx) / (nn * a00)  # first moment along the wall, / h
+                    fade = max(0.0, 1.0 - mt / TANGENTIAL_MOMENT_MAX)
+                ug += fade * (uc - ug)
+                wg += fade * (wc - wg)
             rho[i] = max(rb, floor)  # walls push, never pull: no tension at a wall
             u[i] = 2.0 * vwx - ug
             w[i] = 2.0 * vwz - wg

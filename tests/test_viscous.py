@@ -116,3 +116,29 @@ def test_corrected_ghost_velocity_stays_within_the_fluid_velocities_it_interpola
     assert saw_fluid.sum() > 20
     assert ug.min() >= -1e-15 and ug.max() <= U + 1e-15
     assert wg.min() >= -1e-15 and wg.max() <= U + 1e-15
+
+
+def test_corrected_ghost_velocity_fades_to_shepards_where_the_support_is_lopsided_along_the_wall():
+    """Where a free surface cuts a ghost's support as well as the wall, its first moment
+    along the wall grows; the corrected value fades to Shepard's by 0.1 h of it. In the tank
+    with u = U x / W (varying across the side walls, which cut the support across: Shepard's
+    value is biased there), the side walls' values differ from Shepard's at mid-depth and equal
+    them within h / 2 of the free surface."""
+    def wall_velocities(method):
+        sc = example_scene("hydrostatic", physics={"mdbc_velocity": method})
+        p = build_particles(sc)
+        fl = p.kind == 0
+        p.u[fl] = 1.0e-3 * p.x[fl] / 0.1
+        sim = Simulation(sc, p)
+        sim.derivatives()
+        return sim.snapshot(), sc.h
+
+    shepard, h = wall_velocities("shepard")
+    corrected, _ = wall_velocities("corrected")
+    x, z = shepard["x"], shepard["z"]
+    side = (shepard["kind"] == 1) & ((x < 0.0) | (x > 0.1)) & (np.abs(x - 0.05) < 0.05 + h)
+    mid = side & (np.abs(z - 0.025) < 0.005)
+    top = side & (z > 0.05 - 0.5 * h) & (z < 0.05)
+    assert mid.sum() >= 8 and top.sum() >= 2
+    assert np.abs(corrected["u"][mid] - shepard["u"][mid]).min() > 5.0e-7  # 0.05 % of U
+    assert np.abs(corrected["u"][top] - shepard["u"][top]).max() < 1.0e-12
