@@ -176,8 +176,9 @@ class Physics:
     density_diffusion_reference: str = "spec"
     # remove the laminar term's first-order error 2 nu G . grad u where the support is full
     viscous_correction: bool = False
-    # divide the (corrected) laminar term by div r / 2 where the support is full, a pair by the
-    # mean of its particles' factors from the last evaluation (needs viscous_correction)
+    # divide the (corrected) laminar term by its lattice normaliser N where the support is full,
+    # a pair by the mean of its particles' factors from the last evaluation (needs
+    # viscous_correction; forces.viscous_scale_factors)
     viscous_normalisation: bool = False
     # beta: interior density relaxes towards the particles' packing at a rate beta c0 / h
     # (solver/packing.py); null: off
@@ -542,7 +543,8 @@ def validate(scene: Scene) -> None:
             f"physics.density_update: {ph.density_update!r} is not one of {', '.join(DENSITY_UPDATES)}")
     if ph.viscous_normalisation and not ph.viscous_correction:
         raise SceneError("physics.viscous_normalisation: needs physics.viscous_correction: true (it "
-                         "normalises the corrected laminar term by the div r that the correction sums)")
+                         "normalises the corrected laminar term, where the correction's div r finds "
+                         "full support)")
     if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
         raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
     _validate_cfl_rule(scene)

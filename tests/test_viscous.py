@@ -142,3 +142,27 @@ def test_corrected_ghost_velocity_fades_to_shepards_where_the_support_is_lopside
     assert mid.sum() >= 8 and top.sum() >= 2
     assert np.abs(corrected["u"][mid] - shepard["u"][mid]).min() > 5.0e-7  # 0.05 % of U
     assert np.abs(corrected["u"][top] - shepard["u"][top]).max() < 1.0e-12
+
+
+def test_normalisation_needs_the_correction_and_resumes_exactly():
+    """The option is refused without viscous_correction, naming both keys; a simulation
+    restored from its state continues bit for bit (the factors of the last evaluation are
+    part of the state)."""
+    from solver.scene import SceneError
+    with pytest.raises(SceneError, match="viscous_normalisation.*viscous_correction: true"):
+        example_scene("couette", physics={"viscous_normalisation": True})
+    sc = example_scene("couette", physics={"viscous_correction": True, "viscous_normalisation": True})
+    p = build_particles(sc)
+    fl = p.kind == 0
+    p.x[fl] += np.random.default_rng(3).uniform(-0.1, 0.1, fl.sum()) * sc.dp
+    whole = Simulation(sc, p)
+    for _ in range(10):
+        whole.step()
+    state = whole.state()
+    for _ in range(10):
+        whole.step()
+    resumed = Simulation(sc, build_particles(sc))
+    resumed.restore(state)
+    for _ in range(10):
+        resumed.step()
+    assert np.array_equal(whole.u, resumed.u) and np.array_equal(whole.x, resumed.x)
