@@ -687,8 +687,9 @@ def viscous_scale_factors(out, kind, n, norm_slot, scale):
 
     By Taylor expansion the corrected term is nu sum_b V_b (-F) r^2 / (r^2 + eta^2)
     (r_ab . grad grad u . r_ab): for the isotropic u = |r|^2 / 4 (laplacian 1) it gives nu N,
-    N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)), which a continuous kernel without eta makes 1. On a square lattice at Ch 1.8, N = 0.982 (0.995 from div r / 2, the rest
-    from eta), and so is the film's response nu u''. Dividing by N removes the isotropic part
+    N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)), which a continuous kernel without eta makes 1.
+    On a square lattice at Ch 1.8, N = 0.982 (0.995 from div r / 2, the rest from eta), and so
+    is the film's response nu u''. Dividing by N removes the isotropic part
     of that error. Near the free surface (div r < 1.9) the support is cut and the term is left
     as it is."""
     for i in nb.prange(n):
