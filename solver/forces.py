@@ -61,8 +61,8 @@ LAPG, SUPP, NQ_STRAIN = 16, 17, 18
 def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
             velocity_gradient: bool = False, implicit: bool = False,
             strain_correction: bool = False, volume: bool = False, viscous_scale: bool = False) -> int:
-    nq = volume_slot(shifting, shift_correction, viscous_correction, velocity_gradient,
-                     strain_correction) + (1 if volume else 0) + (1 if viscous_scale else 0)
+    nq = norm_slot(shifting, shift_correction, viscous_correction, velocity_gradient, strain_correction,
+                   volume) + (1 if viscous_scale else 0)
     return nq + 1 if implicit else nq
 
 
@@ -76,6 +76,13 @@ def volume_slot(shifting: bool, shift_correction: bool, viscous_correction: bool
     else:
         nq = NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
     return nq
+
+
+def norm_slot(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
+              velocity_gradient: bool = False, strain_correction: bool = False, volume: bool = False) -> int:
+    """The laminar normaliser's slot (``viscous_scale``): after the volume relaxation's."""
+    return volume_slot(shifting, shift_correction, viscous_correction, velocity_gradient,
+                       strain_correction) + (1 if volume else 0)
 
 
 class PairList(NamedTuple):
@@ -277,7 +284,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     implicit = implicit_walls > 0.0
     VOLC = volume_slot(shifting, shift_correction, viscous_correction, variable_viscosity,
                        strain_correction)
-    NORM = VOLC + 1 if volume else VOLC
+    NORM = norm_slot(shifting, shift_correction, viscous_correction, variable_viscosity, strain_correction,
+                     volume)
     DIAG = NORM + 1 if viscous_scale else NORM
 
     @nb.njit(cache=True, fastmath=FASTMATH)

@@ -92,10 +92,9 @@ class Simulation:
         self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
                                  self.variable_viscosity, self.implicit, self.strain_correction,
                                  self.volume_relaxation > 0, self.viscous_normalisation)
-        # the laminar normaliser's slot: after the volume's (``forces.make_pair_loop``)
-        self.norm_slot = forces.volume_slot(shifting_on, self.correct_shift, self.viscous_correction,
-                                            self.variable_viscosity, self.strain_correction) + \
-            (1 if self.volume_relaxation > 0 else 0)
+        self.norm_slot = forces.norm_slot(shifting_on, self.correct_shift, self.viscous_correction,
+                                          self.variable_viscosity, self.strain_correction,
+                                          self.volume_relaxation > 0)
         # the pair loop's compile-time switches (``forces.make_pair_loop``)
         self.pair_options = dict(
             diffusion=self.diffusion, shifting=shifting_on, shift_correction=self.correct_shift,

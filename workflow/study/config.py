@@ -102,16 +102,16 @@ def validate(config: dict) -> dict:
     if errors:  # every problem at once, each naming its key
         raise ConfigError("; ".join(f"config key {_path(e)}: {_message(e)}" for e in errors))
     try:
-        cases = expand(cfg["grid"], cfg.get("extra_cases"), lambda *point: realisations(cfg, *point))
+        expanded = cases(cfg)
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
-    if not cases:
+    if not expanded:
         raise ConfigError("config key grid.exclude: it leaves out every combination of grid.dp, grid.ch "
                           "and grid.shifting, and extra_cases is empty: there is no case to run")
     # every case must make a valid solver case: check now, before any job starts
     from solver.conveyor import case_from_dict
     from solver.scene import SceneError
-    for c in cases:
+    for c in expanded:
         try:
             case_from_dict(case_dict(cfg, c))
         except SceneError as exc:
