@@ -59,6 +59,9 @@ VARIANTS = {
     # examples/conveyor_fast.yaml as shipped: its settings, its 1 s averaging window and its
     # steady.min_time (2 s, where conveyor.yaml takes the 4 s default)
     "fast_average_1s": example_overrides("conveyor_fast"),
+    # the example before its laminar term's two corrections (until 2026-12-04): the Shepard ghost
+    # velocity and the laminar term without its normaliser
+    "fast_shepard": example_overrides("conveyor_fast") + ["mdbc_velocity=shepard", "viscous_normalisation=false"],
     # the example before its sub-stepped laminar term (until 2026-12-03): the laminar term in
     # the explicit step (auto_substepped keeps it there at dp = 1 mm), C_CFL 0.4 on the
     # acoustic and force limits, 0.2 on the viscous one

@@ -122,7 +122,7 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
     assert changed == {"name", "shifting", "shift_min_speed", "shift_near_surface", "viscous_correction",
-                       "start_velocity", "cfl", "cfl_rule",
+                       "viscous_normalisation", "mdbc_velocity", "start_velocity", "cfl", "cfl_rule",
                        "cfl_viscous", "viscous_update", "volume_relaxation", "density_diffusion_reference",
                        "steady"}
     # the fast example averages over 1 s, and from min_time 2 s: the start's transient measured
@@ -139,6 +139,7 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
     assert fast.shift_min_speed == 0.5
     assert fast.shift_near_surface == "tangential"  # lind's, when the example runs with shifting=lind
     assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
+    assert (fast.viscous_normalisation, fast.mdbc_velocity) == (True, "corrected")
     assert fast.h_n == paper().h_n
     build_scene(replace(fast, dp=4.0e-3, ch=1.5))
 

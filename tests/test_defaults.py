@@ -111,7 +111,7 @@ def test_campaign_configs_set_only_what_differs_from_a_default(name):
 # the keys of the scheme's measured deviations from SPEC section 6 (docs/conveyor.md)
 SCHEME_KEYS = {"cfl", "cfl_viscous", "viscous_update", "viscous_correction", "volume_relaxation",
                "density_diffusion_reference", "start_velocity", "shift_min_speed", "shift_near_surface",
-               "density_update", "cfl_rule"}
+               "density_update", "cfl_rule", "viscous_normalisation", "mdbc_velocity"}
 
 
 def test_paper_config_pins_the_default_case():
