@@ -386,3 +386,22 @@ def test_a_start_perturbation_moves_each_point_by_at_most_its_amplitude_and_is_s
         case_from_dict({"dp": 2.5e-3, "start_perturbation": 0.02})
     with pytest.raises(SceneError, match="case.perturbation_seed"):
         case_from_dict({"dp": 2.5e-3, "perturbation_seed": -1})
+
+
+def test_toe_profile_theory_keeps_the_stations_and_the_flux():
+    """benchmarks/toe_profile.py: the lubrication front's depth at SPEC's stations (section 5),
+    and its second-order long-wave correction of the profile: zero on the belt, zero net flux
+    (the depth-mean of u* stays 1), independent of the difference step, and nil in the
+    uniform zone."""
+    tp = load_benchmark("toe_profile")
+    for x_star, eta in ((0.76, 0.7379), (1.5, 0.8516), (9.7, 0.99866)):
+        assert tp.eta_of_xi(x_star) == pytest.approx(eta, abs=5e-5)
+        assert tp.xi_of_eta(eta) == pytest.approx(x_star, rel=2e-3)
+    s, d = tp.second_order_profile(0.76)
+    assert d[0] == 0.0
+    assert abs(np.trapezoid(d, s)) < 1e-6 and np.abs(d).max() > 1e-3
+    _, d_fine = tp.second_order_profile(0.76, dx=5e-4)
+    assert np.abs(d_fine - d).max() < 1e-4
+    assert np.abs(tp.second_order_profile(9.7)[1]).max() < 1e-4
+    s, d = tp.inertial_profile(0.76, 0.35)
+    assert d[0] == 0.0 and abs(np.trapezoid(d, s)) < 1e-9
