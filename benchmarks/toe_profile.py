@@ -124,8 +124,9 @@ def run_report(path: str) -> None:
         u = u.values
         theory = np.where(z <= eta, 3 * (z / eta - z ** 2 / (2 * eta ** 2)), np.nan)
         local = np.where(z <= depth, 3 * (z / depth - z ** 2 / (2 * depth ** 2)), np.nan)
-        print(f"  x* = {station}: depth {depth:.4f} h_n, theory {eta:.4f} (the theory's depth at x* = "
-              f"{xi_of_eta(min(depth, 1 - 1e-12)):.3f}); RMS against the theory {_rms(u, theory):.4f}, against "
+        where = f"x* = {xi_of_eta(depth):.3f}" if depth < 1.0 else "no x*: above h_n"
+        print(f"  x* = {station}: depth {depth:.4f} h_n, theory {eta:.4f} (the theory has it at "
+              f"{where}); RMS against the theory {_rms(u, theory):.4f}, against "
               f"the parabola on the run's depth {_rms(u, local):.4f}")
         if station < 2.0:
             for zz in HEIGHTS:
