@@ -45,6 +45,10 @@ def example_overrides(name: str, keep_steady: tuple[str, ...] = ()) -> list[str]
     return top + steady
 
 
+# the laminar term before its two corrections (the fast example until 2026-12-04): the Shepard
+# ghost velocity and no normaliser
+BEFORE_CORRECTIONS = ["mdbc_velocity=shepard", "viscous_normalisation=false"]
+
 # --set overrides of each variant on top of examples/conveyor.yaml (which is the shipped case)
 VARIANTS = {
     "shipped": [],
@@ -59,19 +63,18 @@ VARIANTS = {
     # examples/conveyor_fast.yaml as shipped: its settings, its 1 s averaging window and its
     # steady.min_time (2 s, where conveyor.yaml takes the 4 s default)
     "fast_average_1s": example_overrides("conveyor_fast"),
-    # the example before its laminar term's two corrections (until 2026-12-04): the Shepard ghost
-    # velocity and the laminar term without its normaliser
-    "fast_shepard": example_overrides("conveyor_fast") + ["mdbc_velocity=shepard", "viscous_normalisation=false"],
+    # the example before its laminar term's two corrections (until 2026-12-04)
+    "fast_shepard": example_overrides("conveyor_fast") + BEFORE_CORRECTIONS,
     # the example before its sub-stepped laminar term (until 2026-12-03): the laminar term in
     # the explicit step (auto_substepped keeps it there at dp = 1 mm), C_CFL 0.4 on the
-    # acoustic and force limits, 0.2 on the viscous one
-    "fast_explicit": example_overrides("conveyor_fast") + ["viscous_update=auto_substepped", "cfl=0.4",
-                                                           "cfl_rule=fixed"],
+    # acoustic and force limits, 0.2 on the viscous one, and no corrections
+    "fast_explicit": example_overrides("conveyor_fast") + BEFORE_CORRECTIONS + [
+        "viscous_update=auto_substepped", "cfl=0.4", "cfl_rule=fixed"],
     # the same with a longer step: C_CFL 0.5 on the acoustic and force limits, 0.25 on the
     # viscous one; measured, not adopted: lind diverges with it, the two limits together
     # exceed the integrator's joint edge (docs/numerics.md, "The two limits add up")
-    "fast_cfl_0.5": example_overrides("conveyor_fast") + ["viscous_update=auto_substepped", "cfl=0.5",
-                                                          "cfl_viscous=0.25", "cfl_rule=fixed"],
+    "fast_cfl_0.5": example_overrides("conveyor_fast") + BEFORE_CORRECTIONS + [
+        "viscous_update=auto_substepped", "cfl=0.5", "cfl_viscous=0.25", "cfl_rule=fixed"],
     # the example (its laminar term sub-stepped, no viscous limit on dt) at other acoustic C, as
     # set (cfl_rule: damping would take 0.7 to 0.63 here)
     **{f"fast_substepped_cfl_{c}": example_overrides("conveyor_fast") + ["viscous_update=substepped", f"cfl={c}",
