@@ -330,8 +330,8 @@ def fast_scheme_film(update: str, dp: float = 1.0e-3, ch: float = 1.8):
     """The film of SPEC section 7 (examples/film.yaml: the paper fluid, h_n deep, on the 15.3 deg
     incline, periodic over 24 dp) at dp and Ch with the physics of examples/conveyor_fast.yaml
     (the consistent laminar term, the volume relaxation with the column reference, Skillen)
-    but for its Shepard ghost velocity and no normaliser (the example's corrections of the
-    laminar term: docs/numerics.md), and the given viscous update, from rest."""
+    but with SPEC's Shepard ghost velocity and no normaliser, where the example now corrects
+    both (docs/numerics.md, "On the periodic film"), and the given viscous update, from rest."""
     H = 0.01876
     L = 24 * dp
     return example_scene(
