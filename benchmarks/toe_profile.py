@@ -29,29 +29,22 @@ Usage: python benchmarks/toe_profile.py RUN.nc [RUN.nc ...] [--theory]
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from solver import lubrication  # noqa: E402
 
 SLOPE = np.radians(15.3)
 HEIGHTS = (0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6)
 
 
-def eta_of_xi(xi: float, tan_theta: float = np.tan(SLOPE)) -> float:
-    """The lubrication front's depth eta = h / h_n at xi = x* upslope from the toe
-    (xi tan(theta) = atanh(eta) - eta), by bisection."""
-    lo, hi = 0.0, 1.0 - 1e-15
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if np.arctanh(mid) - mid > xi * tan_theta:
-            hi = mid
-        else:
-            lo = mid
-    return 0.5 * (lo + hi)
-
-
-def xi_of_eta(eta: float) -> float:
-    return (np.arctanh(eta) - eta) / np.tan(SLOPE)
+def eta_of_xi(xi: float) -> float:
+    """The lubrication front's depth eta = h / h_n at xi = x* upslope from the toe."""
+    return lubrication.front_eta(xi, SLOPE)
 
 
 def _cumulative(y: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -122,9 +115,9 @@ def run_report(path: str) -> None:
         u = velocity.sel(station=station)
         z = u["z_star"].values
         u = u.values
-        theory = np.where(z <= eta, 3 * (z / eta - z ** 2 / (2 * eta ** 2)), np.nan)
-        local = np.where(z <= depth, 3 * (z / depth - z ** 2 / (2 * depth ** 2)), np.nan)
-        where = f"x* = {xi_of_eta(depth):.3f}" if depth < 1.0 else "no x*: above h_n"
+        theory = np.where(z <= eta, lubrication.belt_velocity(z / eta), np.nan)
+        local = np.where(z <= depth, lubrication.belt_velocity(z / depth), np.nan)
+        where = f"x* = {float(lubrication.xi_star(depth, SLOPE)):.3f}" if depth < 1.0 else "no x*: above h_n"
         print(f"  x* = {station}: depth {depth:.4f} h_n, theory {eta:.4f} (the theory has it at "
               f"{where}); RMS against the theory {_rms(u, theory):.4f}, against "
               f"the parabola on the run's depth {_rms(u, local):.4f}")

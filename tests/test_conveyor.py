@@ -389,14 +389,11 @@ def test_a_start_perturbation_moves_each_point_by_at_most_its_amplitude_and_is_s
 
 
 def test_toe_profile_theory_keeps_the_stations_and_the_flux():
-    """benchmarks/toe_profile.py: the lubrication front's depth at SPEC's stations (section 5),
-    and its second-order long-wave correction of the profile: zero on the belt, zero net flux
+    """benchmarks/toe_profile.py: the lubrication front's second-order long-wave correction of
+    the profile (the stations' depths are solver.lubrication's): zero on the belt, zero net flux
     (the depth-mean of u* stays 1), independent of the difference step, and nil in the
     uniform zone."""
     tp = load_benchmark("toe_profile")
-    for x_star, eta in ((0.76, 0.7379), (1.5, 0.8516), (9.7, 0.99866)):
-        assert tp.eta_of_xi(x_star) == pytest.approx(eta, abs=5e-5)
-        assert tp.xi_of_eta(eta) == pytest.approx(x_star, rel=2e-3)
     s, d = tp.second_order_profile(0.76)
     assert d[0] == 0.0
     assert abs(np.trapezoid(d, s)) < 1e-6 and np.abs(d).max() > 1e-3
