@@ -34,6 +34,13 @@ def test_the_case_table_gives_the_metrics_with_their_sampling_error():
     table = case_table(ds)
     assert table.count("0.0077 &plusmn; 0.021") == ds.sizes["case"] - 1
     assert "zeta_f (± 2 se)" in table
+    # the front body's error beside it; a dash where the metrics predate it
+    dashes = table.count("<td>&ndash;</td>")
+    ds["case_zeta_f_body"] = xr.full_like(ds["case_zeta_f"], 0.00357)
+    ds["case_zeta_f_body_se"] = xr.full_like(ds["case_zeta_f"], 0.000105)
+    table = case_table(ds)
+    assert table.count("0.00357 &plusmn; 0.00021") == ds.sizes["case"]
+    assert dashes - table.count("<td>&ndash;</td>") == ds.sizes["case"]
     # zeta_u's jackknife error, in plain decimals to two digits
     ds["case_zeta_u"][:] = 0.0159
     ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], 0.00029)

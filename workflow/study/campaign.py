@@ -10,8 +10,8 @@ import xarray as xr
 from . import stability
 from .grid import Case
 
-SCALARS = ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_se", "zeta_h_paper", "zeta_h_paper_se", "zeta_fs",
-           "zeta_fs_se", "zeta_fs_measured")
+SCALARS = ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se", "zeta_h", "zeta_h_se", "zeta_h_paper",
+           "zeta_h_paper_se", "zeta_fs", "zeta_fs_se", "zeta_fs_measured")
 STATION_METRICS = ("zeta_u", "zeta_u_se", "zeta_u_measured")
 RUN_NUMBERS = {
     "wall_time": ("wall_time_s", "s", "wall-clock time of the run"),

@@ -14,6 +14,9 @@ half the depth's least-squares change through the window T, se_h^2 = se_jack^2 +
 within that of the depth at both its ends. On a depth that does not drift, the fitted slope's
 own noise makes zeta_h's se larger than the window mean's, by a factor of 1.7 on average for
 white noise (tests/test_study.py): conservative.
+
+Beyond SPEC, a diagnostic beside zeta_f: zeta_f_body, the same error of the equivalent front
+(``front_body_velocity_error``), which tells a front that moves from a toe that wanders.
 """
 from __future__ import annotations
 
@@ -38,6 +41,20 @@ def zeta_f_error(t, toe, u_b: float) -> float:
     if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
         return float("nan")
     return front_velocity_fit(t, toe)[1] / u_b
+
+
+def front_body_velocity_error(t, front, u_b: float) -> tuple[float, float]:
+    """(|u_e| / u_b, se / u_b) of the equivalent front x0 + A / h_n (the fluid area A downstream
+    of a lab-fixed point over h_n, ``front_equivalent`` of the run): u_e its least-squares slope
+    over the same last second as zeta_f's (``solver.steady.front_velocity_fit``). A front that
+    advances at constant shape moves it as much as its toe; the nose's wander and particles
+    joining or leaving the tip do not move it. NaN with fewer than 4 samples in that second."""
+    from solver.steady import FRONT_VELOCITY_SPAN, front_velocity_fit
+    t = np.asarray(t, dtype=float)
+    if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
+        return float("nan"), float("nan")
+    slope, se = front_velocity_fit(t, front)
+    return abs(slope) / u_b, se / u_b
 
 
 def zeta_h(depth: float, h_ref: float) -> float:
@@ -147,7 +164,8 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     over its final window, flagged by ``steady = 0`` (the report and figures mark them).
     """
     st = ref["station"].values
-    out = {k: np.nan for k in ("zeta_f", "zeta_f_se") + PROFILE_METRICS + tuple(f"{k}_se" for k in PROFILE_METRICS)}
+    out = {k: np.nan for k in ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se") + PROFILE_METRICS
+           + tuple(f"{k}_se" for k in PROFILE_METRICS)}
     zu, zu_se = np.full(st.size, np.nan), np.full(st.size, np.nan)
     meas = {"zeta_fs_measured": np.nan}
     zu_meas = np.full(st.size, np.nan)
@@ -158,6 +176,9 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         out["zeta_f"] = zeta_f(float(run["front_velocity"]), ub)
         if "toe_position" in run:  # the probe record (absent from hand-made means-only runs)
             out["zeta_f_se"] = zeta_f_error(run["time"].values, run["toe_position"].values, ub)
+        if "front_equivalent" in run:
+            out["zeta_f_body"], out["zeta_f_body_se"] = front_body_velocity_error(
+                run["time"].values, run["front_equivalent"].values, ub)
         surf = run["mean_surface_elevation"]
         vel = run["mean_velocity_star"]
         scalars, zu = profile_metrics(float(run["mean_uniform_depth"]), surf, vel, run, ref, x_star_range)
@@ -183,6 +204,9 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     attrs = {
         "zeta_f": "front velocity error |u*_f - u*_b| / u*_b",
         "zeta_f_se": "standard error of zeta_f from the toe's scatter over its second",
+        "zeta_f_body": "front velocity error of the front's body: |u_e| / u_b, u_e the equivalent "
+                       "front's velocity over zeta_f's second (not SPEC's metric; a diagnostic)",
+        "zeta_f_body_se": "standard error of zeta_f_body from the equivalent front's scatter over its second",
         "zeta_h": "uniform depth error against the computed h_n",
         "zeta_h_paper": "uniform depth error against the paper's normalising depth",
         "zeta_fs": "free-surface RMS error against the theory",
