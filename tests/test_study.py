@@ -440,8 +440,9 @@ def test_zeta_f_error_is_the_scatter_of_the_last_second_toe_slope():
 def test_zeta_f_of_the_front_body_reads_the_fronts_motion_not_the_toes_jumps():
     """A front creeping at 0.3 % u_b whose equivalent front carries white noise of 0.01 mm and
     whose toe, on the same creep, jumps 4 mm ahead for the last 0.3 s (a particle strung
-    ahead of the nose) and wanders by 0.5 mm: case_metrics' zeta_f_body recovers the
-    creep within 2 of its se in 95 of 100 records (expected 95 %), while zeta_f reads the jump.
+    ahead of the nose) and scatters by 0.5 mm: case_metrics' zeta_f_body recovers the creep
+    within 2 of its se in 90-99 of 100 records (95 expected; measured 94), its se below 0.02 %,
+    while zeta_f reads the jump (median error above 2 %).
     Without the equivalent front in the record (metrics of an older run) it is NaN."""
     u_b, creep = 0.075, 0.003
     t = np.arange(0.0, 4.0 + 1e-9, 0.02)
