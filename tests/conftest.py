@@ -1,7 +1,4 @@
 import copy
-import shutil
-import subprocess
-import tempfile
 from pathlib import Path
 
 import pytest
@@ -83,37 +80,3 @@ def worst_density_deviation(sim, t_end: float, t_from: float = 0.2) -> float:
 @pytest.fixture
 def examples_dir():
     return EXAMPLES
-
-
-# ---- the miniature campaign (tests/test_campaign_e2e.py), run beside the other tests --------
-MINI_CAMPAIGN = pytest.StashKey[tuple]()
-
-
-def pytest_collection_finish(session):
-    """Start the miniature campaign's Snakemake run in the background as soon as the tests
-    are known, if any of them uses it: it runs in its own process (its numba compile and its
-    cases) beside the tests that come before its module, which awaits it (``campaign``). Its
-    output goes to files in its directory, so that no pipe fills while nobody reads it."""
-    users = [item for item in session.items
-             if getattr(item, "module", None) is not None and item.module.__name__.endswith("test_campaign_e2e")
-             and "campaign" in getattr(item, "fixturenames", ())]
-    if not users:
-        return
-    e2e = users[0].module
-    work = Path(tempfile.mkdtemp(prefix="sph-surge-mini-"))
-    with open(work / "snakemake.out", "w") as out, open(work / "snakemake.err", "w") as err:
-        proc = subprocess.Popen(e2e.snakemake_command(e2e.MINI), cwd=work, stdout=out, stderr=err)
-    session.config.stash[MINI_CAMPAIGN] = (work, proc)
-
-
-def pytest_sessionfinish(session, exitstatus):
-    """Stop the miniature campaign if the session ends before awaiting it (-x, a failure);
-    remove its directory after a session that passed."""
-    run = session.config.stash.get(MINI_CAMPAIGN, None)
-    if run is None:
-        return
-    if run[1].poll() is None:
-        run[1].kill()
-        run[1].wait()
-    if exitstatus == 0:
-        shutil.rmtree(run[0], ignore_errors=True)

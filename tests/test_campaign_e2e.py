@@ -19,25 +19,17 @@ ROOT = Path(__file__).resolve().parent.parent
 MINI = ROOT / "tests" / "data" / "mini.yaml"
 
 
-def snakemake_command(configfile, *args) -> list[str]:
-    return [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--configfile", str(configfile),
-            "--cores", "2", *args]
-
-
 def snakemake(cwd, configfile, *args):
-    return subprocess.run(snakemake_command(configfile, *args), cwd=cwd, capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"),
+                           "--configfile", str(configfile), "--cores", "2", *args],
+                          cwd=cwd, capture_output=True, text=True)
 
 
 @pytest.fixture(scope="module")
-def campaign(request):
-    """The miniature campaign's directory. conftest starts its Snakemake run in the background
-    when the session begins (``start_mini_campaign``), so that it runs beside the other tests;
-    here it is awaited."""
-    from conftest import MINI_CAMPAIGN
-    run = request.config.stash.get(MINI_CAMPAIGN, None)
-    assert run is not None, "the miniature campaign was not started (conftest.pytest_collection_finish)"
-    work, proc = run
-    assert proc.wait() == 0, (work / "snakemake.err").read_text()[-4000:]
+def campaign(tmp_path_factory):
+    work = tmp_path_factory.mktemp("campaign")
+    p = snakemake(work, MINI)
+    assert p.returncode == 0, p.stderr[-4000:]
     return work
 
 
