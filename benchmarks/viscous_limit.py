@@ -52,11 +52,16 @@ def film(dp: float, ch: float, end: float, update: str = "explicit", physics=())
     return set_physics(d, physics)
 
 
+def film_depth(sim: Simulation) -> float:
+    """The film's depth: the top of its fluid block (whole rows, ``film``)."""
+    return max(b.z[1] for b in sim.scene.fluid.blocks)
+
+
 def exact_error(sim: Simulation) -> float:
     """RMS of u - u_exact over fluid particles, over the exact surface velocity."""
     s = sim.scene
     f = sim.kind[:sim.n_active] == 0
-    H = max(b.z[1] for b in s.fluid.blocks)
+    H = film_depth(sim)
     return exact.film_rms_error(sim.z[:sim.n_active][f], sim.u[:sim.n_active][f], H, s.gravity[0], s.nu)
 
 
@@ -69,7 +74,7 @@ def film_fit(sim: Simulation) -> tuple[float, float]:
     z, u = sim.z[:sim.n_active][f], sim.u[:sim.n_active][f]
     k = s.gravity[0] / s.nu
     (depth, slip), *_ = np.linalg.lstsq(np.c_[k * z, np.ones_like(z)], u + 0.5 * k * z * z, rcond=None)
-    H = max(b.z[1] for b in s.fluid.blocks)
+    H = film_depth(sim)
     return float(depth), float(slip / (0.5 * k * H * H))
 
 

@@ -29,32 +29,33 @@ def zeta_f(front_velocity: float, u_b: float) -> float:
     return abs(front_velocity) / u_b
 
 
-def zeta_f_error(t, toe, u_b: float) -> float:
-    """Standard error of zeta_f from the toe's own scatter: se of the least-squares toe slope
-    over the last second of the record (the second zeta_f is measured over), widened for the
-    residuals' lag-1 correlation (solver.steady.front_velocity_fit), over u_b. NaN with fewer
-    than 4 samples in that second (no scatter to measure). A wander of the toe slower than
-    the second shows as slope, not scatter: at dp <= 1 mm the one-second velocities of a
-    settled front scatter by up to 1.6 times this se (docs/conveyor.md, "The toe's wander")."""
-    from solver.steady import FRONT_VELOCITY_SPAN, front_velocity_fit
-    t = np.asarray(t, dtype=float)
-    if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
-        return float("nan")
-    return front_velocity_fit(t, toe)[1] / u_b
-
-
-def front_body_velocity_error(t, front, u_b: float) -> tuple[float, float]:
-    """(|u_e| / u_b, se / u_b) of the equivalent front x0 + A / h_n (the fluid area A downstream
-    of a lab-fixed point over h_n, ``front_equivalent`` of the run): u_e its least-squares slope
-    over the same last second as zeta_f's (``solver.steady.front_velocity_fit``). A front that
-    advances at constant shape moves it as much as its toe; the nose's wander and particles
-    joining or leaving the tip do not move it. NaN with fewer than 4 samples in that second."""
+def last_second_velocity(t, position, u_b: float) -> tuple[float, float]:
+    """(|slope| / u_b, se / u_b) of a front position's least-squares slope over the last second
+    of the record (the second zeta_f is measured over), se widened for the residuals' lag-1
+    correlation (solver.steady.front_velocity_fit). NaN, NaN with fewer than 4 samples in that
+    second (no scatter to measure)."""
     from solver.steady import FRONT_VELOCITY_SPAN, front_velocity_fit
     t = np.asarray(t, dtype=float)
     if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
         return float("nan"), float("nan")
-    slope, se = front_velocity_fit(t, front)
+    slope, se = front_velocity_fit(t, position)
     return abs(slope) / u_b, se / u_b
+
+
+def zeta_f_error(t, toe, u_b: float) -> float:
+    """Standard error of zeta_f from the toe's own scatter (``last_second_velocity``). A wander
+    of the toe slower than the second shows as slope, not scatter: at dp <= 1 mm the one-second
+    velocities of a settled front scatter by up to 1.6 times this se (docs/conveyor.md, "The
+    toe's wander")."""
+    return last_second_velocity(t, toe, u_b)[1]
+
+
+def front_body_velocity_error(t, front, u_b: float) -> tuple[float, float]:
+    """(|u_e| / u_b, se / u_b) of the equivalent front x0 + A / h_n (the fluid area A downstream
+    of a lab-fixed point over h_n, ``front_equivalent`` of the run), u_e its slope over zeta_f's
+    second (``last_second_velocity``). A front that advances at constant shape moves it as much
+    as its toe; the nose's wander and particles joining or leaving the tip do not move it."""
+    return last_second_velocity(t, front, u_b)
 
 
 def zeta_h(depth: float, h_ref: float) -> float:
