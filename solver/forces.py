@@ -9,7 +9,10 @@ Each pair (a, b) is visited once (b after a in a's grid column, or in the next c
 within 2h of a in z: two ranges of the z-sorted columns, ``cells``) and its contributions are
 added to both particles, into per-thread accumulators ``acc[t, i, q]`` (no write races; the
 slots of one particle share a cache line), reduced afterwards; a's sums stay in registers
-over the b loop.
+over the b loop. For each a the candidates b are first listed without a branch (each one
+written, the count advanced only for those within 2h and not wall-wall), then the pair terms
+run over that list: in a flowing arrangement the 2h test fails for about half the candidates
+at random, and a branch per candidate then mispredicts (benchmarks/pair_loop.py --jitter).
 Slots q (named below): ax, az, drho/dt; with shifting gradC_x, gradC_z, div r and the
 kernel-weighted sum of the inward normals of nearby wall particles (where shifting must not
 push); with the shifting density correction, div(dr) of the previous step's shift.
@@ -310,6 +313,14 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
         vm = 0.0
         npl = 0
         cap = pair_i.shape[1]
+        # room for one particle's candidates: the rest of its column and the next column's window
+        widest = 0
+        for ix in range(ncx):
+            widest = max(widest, start[(ix + 1) * ncz] - start[ix * ncz])
+        near_b = np.empty(2 * widest + 1, dtype=np.uint64)
+        near_dx = np.empty(2 * widest + 1)
+        near_dz = np.empty(2 * widest + 1)
+        near_r2 = np.empty(2 * widest + 1)
         for ix in range(split[t], split[t + 1]):
             # half stencil: b > a in this column and every b of the next column, each
             # within 2h of a in z. Columns are sorted by z (``cells.sort_cells_by``) and a
@@ -360,134 +371,145 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                     nx_hi = max(nx_hi, nx_lo)
                     while nx_hi < nx_end and z[nx_hi] < z_hi:
                         nx_hi += 1
+                    # the candidates within 2h (and not wall-wall) listed without a branch:
+                    # every candidate is written, the count advances only for those kept. In a
+                    # flowing arrangement about half the candidates fail the 2h test at random,
+                    # which a branch per candidate mispredicts (benchmarks/pair_loop.py --jitter)
+                    n_near = 0
                     for side in range(2):
                         first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
                         # unsigned: no negative-index wrap-around on the loads and stores of b
                         for b in range(np.uint64(first), np.uint64(b1)):
-                            kb = kind[b]
-                            if ka + kb == 2:
-                                continue
                             dx = xa - (x[b] + shift)
                             dz = za - z[b]
                             r2 = dx * dx + dz * dz
-                            if r2 >= four_h2:
-                                continue
-                            q = math.sqrt(r2) * inv_h
-                            F = grad_factor(q, fac)
-                            rb = rho[b]
-                            du = ua - u[b]
-                            dw = wa - w[b]
-                            vdotr = du * dx + dw * dz
-                            rdotg = F * r2
-                            mb = mass[b]
-                            irb = irho[b]
-                            Vb = mb * irb
-                            inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
-                            ca, cb = continuity_terms(ra, rb, F, vdotr)
-                            s_drho += ca * Vb
-                            drho_b = cb * Va
-                            # momentum: pressure and laminar viscosity
-                            pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
-                            if variable_viscosity:
-                                nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
-                                vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
+                            near_b[n_near] = b
+                            near_dx[n_near] = dx
+                            near_dz[n_near] = dz
+                            near_r2[n_near] = r2
+                            n_near += (r2 < four_h2) & (ka + kind[b] != 2)
+                    for m in range(n_near):
+                        b = near_b[m]
+                        kb = kind[b]
+                        dx = near_dx[m]
+                        dz = near_dz[m]
+                        r2 = near_r2[m]
+                        q = math.sqrt(r2) * inv_h
+                        F = grad_factor(q, fac)
+                        rb = rho[b]
+                        du = ua - u[b]
+                        dw = wa - w[b]
+                        vdotr = du * dx + dw * dz
+                        rdotg = F * r2
+                        mb = mass[b]
+                        irb = irho[b]
+                        Vb = mb * irb
+                        inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
+                        ca, cb = continuity_terms(ra, rb, F, vdotr)
+                        s_drho += ca * Vb
+                        drho_b = cb * Va
+                        # momentum: pressure and laminar viscosity
+                        pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
+                        if variable_viscosity:
+                            nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
+                            vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
+                        else:
+                            vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
+                        if viscous_scale:
+                            if kb == 1:
+                                vt *= sca
+                            elif ka == 1:
+                                vt *= f.vscale[b]
                             else:
-                                vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
-                            if viscous_scale:
-                                if kb == 1:
-                                    vt *= sca
-                                elif ka == 1:
-                                    vt *= f.vscale[b]
+                                vt *= 0.5 * (sca + f.vscale[b])
+                            e = -0.5 * rdotg * r2 * inv_r2e
+                            s_norm += Vb * e
+                            at[b, NORM] += Va * e
+                        if artificial:
+                            pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
+                        fx = -pt * dx + vt * du
+                        fz = -pt * dz + vt * dw
+                        s_ax += mb * fx
+                        s_az += mb * fz
+                        at[b, AX] -= ma * fx
+                        at[b, AZ] -= ma * fz
+                        if implicit:  # k_ab = -vt
+                            if ka + kb == 0:
+                                if npl < cap:
+                                    pair_i[t, npl] = a
+                                    pair_j[t, npl] = b
+                                    pair_k[t, npl] = -vt
+                                npl += 1
+                                s_diag -= mb * vt
+                                at[b, DIAG] -= ma * vt
+                            elif kb == 1:
+                                s_diag -= implicit_walls * mb * vt
+                            else:
+                                at[b, DIAG] -= implicit_walls * ma * vt
+                        vr = abs(h * vdotr * inv_r2e)
+                        if vr > vm:
+                            vm = vr
+                        if diffusion:
+                            if ka + kb == 0:  # fluid pairs only
+                                g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
+                                if column_reference:
+                                    ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
+                                    s_drho += ge * Vb
+                                    drho_b -= ge * Va
                                 else:
-                                    vt *= 0.5 * (sca + f.vscale[b])
-                                e = -0.5 * rdotg * r2 * inv_r2e
-                                s_norm += Vb * e
-                                at[b, NORM] += Va * e
-                            if artificial:
-                                pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
-                            fx = -pt * dx + vt * du
-                            fz = -pt * dz + vt * dw
-                            s_ax += mb * fx
-                            s_az += mb * fz
-                            at[b, AX] -= ma * fx
-                            at[b, AZ] -= ma * fz
-                            if implicit:  # k_ab = -vt
-                                if ka + kb == 0:
-                                    if npl < cap:
-                                        pair_i[t, npl] = a
-                                        pair_j[t, npl] = b
-                                        pair_k[t, npl] = -vt
-                                    npl += 1
-                                    s_diag -= mb * vt
-                                    at[b, DIAG] -= ma * vt
-                                elif kb == 1:
-                                    s_diag -= implicit_walls * mb * vt
-                                else:
-                                    at[b, DIAG] -= implicit_walls * ma * vt
-                            vr = abs(h * vdotr * inv_r2e)
-                            if vr > vm:
-                                vm = vr
-                            if diffusion:
-                                if ka + kb == 0:  # fluid pairs only
-                                    g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
-                                    if column_reference:
-                                        ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
-                                        s_drho += ge * Vb
-                                        drho_b -= ge * Va
-                                    else:
-                                        ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
-                                        s_drho += ea * Vb
-                                        drho_b += eb * Va
-                            at[b, DRHO] += drho_b
-                            if shifting:
-                                gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
-                                cell_b = f.cell[b]
-                                s_gcx += cell_b * gx
-                                s_gcz += cell_b * gz
-                                s_divr += cell_b * gdiv
-                                at[b, GCX] -= cell_a * gx
-                                at[b, GCZ] -= cell_a * gz
-                                at[b, DIVR] += cell_a * gdiv
-                                if kb == 1:
-                                    s_wnx -= F * f.wnx[b]
-                                    s_wnz -= F * f.wnz[b]
-                                elif ka == 1:
-                                    at[b, WNX] -= F * f.wnx[a]
-                                    at[b, WNZ] -= F * f.wnz[a]
-                            if viscous_correction:
-                                # gradW_ab = F r_ab; gradW_ba = -gradW_ab
-                                s_vgx += Vb * F * dx
-                                s_vgz += Vb * F * dz
-                                at[b, VGX] -= Va * F * dx
-                                at[b, VGZ] -= Va * F * dz
-                                s_vdivr -= Vb * rdotg
-                                at[b, VDIVR] -= Va * rdotg
-                            if velocity_gradient:
-                                # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
-                                s_dux -= Vb * du * F * dx
-                                s_duz -= Vb * du * F * dz
-                                s_dwx -= Vb * dw * F * dx
-                                s_dwz -= Vb * dw * F * dz
-                                at[b, DUX] -= Va * du * F * dx
-                                at[b, DUZ] -= Va * du * F * dz
-                                at[b, DWX] -= Va * dw * F * dx
-                                at[b, DWZ] -= Va * dw * F * dz
-                            if strain_correction:
-                                if ka + kb == 0:
-                                    lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
-                                    s_lapg += Vb * lg
-                                    at[b, LAPG] -= Va * lg
-                                    s_supp -= 0.5 * Vb * rdotg
-                                    at[b, SUPP] -= 0.5 * Va * rdotg
-                            if volume:
-                                Wab = w_value(q, alpha)
-                                s_volc += Vb * Wab
-                                at[b, VOLC] += Va * Wab
-                            if shift_correction:
-                                # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
-                                e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
-                                s_divdr += Vb * e
-                                at[b, DIVDR] += Va * e
+                                    ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
+                                    s_drho += ea * Vb
+                                    drho_b += eb * Va
+                        at[b, DRHO] += drho_b
+                        if shifting:
+                            gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
+                            cell_b = f.cell[b]
+                            s_gcx += cell_b * gx
+                            s_gcz += cell_b * gz
+                            s_divr += cell_b * gdiv
+                            at[b, GCX] -= cell_a * gx
+                            at[b, GCZ] -= cell_a * gz
+                            at[b, DIVR] += cell_a * gdiv
+                            if kb == 1:
+                                s_wnx -= F * f.wnx[b]
+                                s_wnz -= F * f.wnz[b]
+                            elif ka == 1:
+                                at[b, WNX] -= F * f.wnx[a]
+                                at[b, WNZ] -= F * f.wnz[a]
+                        if viscous_correction:
+                            # gradW_ab = F r_ab; gradW_ba = -gradW_ab
+                            s_vgx += Vb * F * dx
+                            s_vgz += Vb * F * dz
+                            at[b, VGX] -= Va * F * dx
+                            at[b, VGZ] -= Va * F * dz
+                            s_vdivr -= Vb * rdotg
+                            at[b, VDIVR] -= Va * rdotg
+                        if velocity_gradient:
+                            # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
+                            s_dux -= Vb * du * F * dx
+                            s_duz -= Vb * du * F * dz
+                            s_dwx -= Vb * dw * F * dx
+                            s_dwz -= Vb * dw * F * dz
+                            at[b, DUX] -= Va * du * F * dx
+                            at[b, DUZ] -= Va * du * F * dz
+                            at[b, DWX] -= Va * dw * F * dx
+                            at[b, DWZ] -= Va * dw * F * dz
+                        if strain_correction:
+                            if ka + kb == 0:
+                                lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
+                                s_lapg += Vb * lg
+                                at[b, LAPG] -= Va * lg
+                                s_supp -= 0.5 * Vb * rdotg
+                                at[b, SUPP] -= 0.5 * Va * rdotg
+                        if volume:
+                            Wab = w_value(q, alpha)
+                            s_volc += Vb * Wab
+                            at[b, VOLC] += Va * Wab
+                        if shift_correction:
+                            # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
+                            e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
+                            s_divdr += Vb * e
+                            at[b, DIVDR] += Va * e
                     at[a, AX] += s_ax
                     at[a, AZ] += s_az
                     at[a, DRHO] += s_drho
