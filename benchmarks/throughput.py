@@ -13,7 +13,7 @@ Usage: python benchmarks/throughput.py [--steps 200] [--ch 1.5 1.8] [--threads 1
                                        [--jitter 0.05]
 --jitter DP moves the fluid particles by up to DP dp first: the layer from rest stays a lattice
 (skillen's shifts there are 1e-13 m), whose exact rows make the pair loop's branches predictable,
-which no flow's arrangement is; lind's shifts of 1e-18 to 1e-10 m already reorder the rows.
+which no flow's arrangement is; lind's shifts (median 5e-18 m) already reorder the rows.
 """
 from __future__ import annotations
 
