@@ -53,7 +53,7 @@ def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, parti
     s = Simulation(scene_from_dict(set_physics(layer_scene(ch, shifting, particles), physics)))
     for _ in range(warmup):
         s.step()
-    if jitter_dp > 0:  # on the lattice the loop took 4.28 ms (Ch 1.5, skillen); 1e-12 dp: 5.28; 1e-3 dp: 6.2
+    if jitter_dp > 0:
         jitter(s, jitter_dp)
         s._sort()
     options = s.pair_options

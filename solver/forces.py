@@ -371,10 +371,8 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
                     nx_hi = max(nx_hi, nx_lo)
                     while nx_hi < nx_end and z[nx_hi] < z_hi:
                         nx_hi += 1
-                    # the candidates within 2h (and not wall-wall) listed without a branch:
-                    # every candidate is written, the count advances only for those kept. In a
-                    # flowing arrangement about half the candidates fail the 2h test at random,
-                    # which a branch per candidate mispredicts (benchmarks/pair_loop.py --jitter)
+                    # the candidates within 2h (and not wall-wall), listed without a branch
+                    # (module docstring)
                     n_near = 0
                     for side in range(2):
                         first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
