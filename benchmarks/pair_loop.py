@@ -1,15 +1,17 @@
 """The pair loop alone, of two solver trees, on the same particle arrays: ms per call.
 
-OLD_TREE's solver/ is copied to a temporary package and imported beside this tree's. One
-simulation of this tree (benchmarks/throughput.py's periodic layer, 40k particles) is
-stepped --warmup times; then the two trees' pair loops, compiled with the same options,
-are called on its arrays in turn, --calls times each, the order swapped every call. Both
-read the same memory, so the host's state and the arrays' placement weigh on both alike
-(whole steps of two simulations in one process do not: the one built first runs faster).
-The first call's summed accumulators of the two are compared (round-off only). One JSON
-line per configuration.
+OLD_TREE's and NEW_TREE's (default: this tree) solver/ are each copied to a temporary
+package and imported. One simulation of this tree (benchmarks/throughput.py's periodic
+layer, 40k particles) is stepped --warmup times; then the two trees' pair loops, compiled
+with the same options, are called on its arrays in turn, --calls times each, the order
+swapped every call. Both read the same memory, so the host's state and the arrays' placement
+weigh on both alike (whole steps of two simulations in one process do not: the one built
+first runs faster). Both are copies because a copy's loop ran 7-8 % slower than the same code
+imported as ``solver`` (identical trees read 0.92-0.93 new/old when only OLD_TREE was copied,
+1.00 with both copied). The first call's summed accumulators of the two are compared
+(round-off only). One JSON line per configuration.
 
-Usage: python benchmarks/pair_loop.py OLD_TREE [--ch 1.5 1.8] [--shifting none skillen lind]
+Usage: python benchmarks/pair_loop.py OLD_TREE [NEW_TREE] [--ch 1.5 1.8] [--shifting none skillen lind]
            [--threads 2] [--calls 60] [--physics KEY=VALUE ...] [--jitter 0 0.05]
 (--jitter DP: the fluid particles moved by up to DP dp first, an arrangement as disordered as a
 flow's; the stepped layer is still a lattice, whose exact rows make the 2h test predictable)
@@ -45,7 +47,7 @@ def import_tree(tree: Path, name: str):
     return importlib.import_module(name)
 
 
-def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, particles: int,
+def measure(old_forces, new_forces, ch: float, shifting: str, calls: int, warmup: int, particles: int,
             physics=(), jitter_dp: float = 0.0) -> dict:
     from solver import forces
     from solver.scene import scene_from_dict
@@ -60,12 +62,14 @@ def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, parti
     forces.pressure_and_inverse_density(s.rho, s.p, s.irho, s.B, s.rho0)
     fields = forces.PairFields(s.x, s.z, s.u, s.w, s.rho, s.p, s.mass, s.kind, s.wnx, s.wnz, s.shift_dx,
                                s.shift_dz, s.nu_p, s.gamma_p, s.cell_volume, s.irho, s.viscous_scale)
-    old_fields = old_forces.PairFields(*fields[:len(old_forces.PairFields._fields)])
-    known = inspect.signature(old_forces.make_pair_loop).parameters  # an older tree's switches
-    if any(v for k, v in options.items() if k not in known):
-        raise SystemExit(f"the old tree's pair loop has no switch for {[k for k in options if k not in known]}")
-    loops = [(old_forces.make_pair_loop(**{k: v for k, v in options.items() if k in known}), old_fields),
-             (forces.make_pair_loop(**options), fields)]
+    loops = []
+    for tree, module in (("old", old_forces), ("new", new_forces)):
+        known = inspect.signature(module.make_pair_loop).parameters  # an older tree's switches
+        if any(v for k, v in options.items() if k not in known):
+            raise SystemExit(f"the {tree} tree's pair loop has no switch for "
+                             f"{[k for k in options if k not in known]}")
+        loops.append((module.make_pair_loop(**{k: v for k, v in options.items() if k in known}),
+                      module.PairFields(*fields[:len(module.PairFields._fields)])))
 
     def call(k):
         fn, f = loops[k]
@@ -93,6 +97,7 @@ def measure(old_forces, ch: float, shifting: str, calls: int, warmup: int, parti
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("old", type=Path)
+    ap.add_argument("new", type=Path, nargs="?", default=ROOT)
     ap.add_argument("--ch", type=float, nargs="+", default=[1.5, 1.8])
     ap.add_argument("--shifting", nargs="+", default=["none", "skillen", "lind"])
     ap.add_argument("--particles", type=int, default=40000)
@@ -106,11 +111,13 @@ def main(argv=None):
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
     old_forces = importlib.import_module(f"{import_tree(a.old.resolve(), 'solver_old').__name__}.forces")
+    new_forces = importlib.import_module(f"{import_tree(a.new.resolve(), 'solver_new').__name__}.forces")
     for ch in a.ch:
         for shifting in a.shifting:
             for amplitude in a.jitter:
-                print(json.dumps({**measure(old_forces, ch, shifting, a.calls, a.warmup, a.particles, a.physics,
-                                            amplitude), "physics": a.physics}), flush=True)
+                row = measure(old_forces, new_forces, ch, shifting, a.calls, a.warmup, a.particles, a.physics,
+                              amplitude)
+                print(json.dumps({**row, "physics": a.physics}), flush=True)
 
 
 if __name__ == "__main__":

@@ -2,14 +2,15 @@
 
 Times the guards' pass (``guards.fluid_health``), the accumulators' reduction
 (``forces.reduce_accumulators``), the cell assignment (``cells.assign_cells``) and the counting
-sort (``cells.counting_sort``) of OLD_TREE (imported beside this tree's, as
-``benchmarks/pair_loop.py`` does) and of this tree, alternated call by call: the median of
+sort (``cells.counting_sort``) of OLD_TREE and NEW_TREE (default: this tree), each imported as
+a copy (as ``benchmarks/pair_loop.py`` does: a copy against the tree imported as ``solver``
+read 0.90-1.12 for identical code), alternated call by call: the median of
 --calls calls each, and the largest difference of their outputs. The arrays are a simulation
 of this tree stepped --warmup times: the throughput layer (benchmarks/throughput.py) or, with
 --case, a conveyor case (its scheme sets how many slots the reduction sums). One JSON line per
 pass.
 
-Usage: python benchmarks/step_passes.py OLD_TREE [--case examples/conveyor_fast.yaml]
+Usage: python benchmarks/step_passes.py OLD_TREE [NEW_TREE] [--case examples/conveyor_fast.yaml]
            [--ch 1.5] [--shifting none] [--particles 40000] [--threads 2] [--calls 200]
 """
 from __future__ import annotations
@@ -78,6 +79,7 @@ def rel_difference(a, b) -> float:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("old", type=Path)
+    ap.add_argument("new", type=Path, nargs="?", default=ROOT)
     ap.add_argument("--case", default=None)
     ap.add_argument("--ch", type=float, default=1.5)
     ap.add_argument("--shifting", default="none")
@@ -87,9 +89,10 @@ def main(argv=None):
     ap.add_argument("--warmup", type=int, default=5)
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
-    old_name = import_tree(a.old.resolve(), "solver_old").__name__
+    names = [import_tree(tree.resolve(), name).__name__ for tree, name in ((a.old, "solver_old"),
+                                                                          (a.new, "solver_new"))]
     trees = [type("tree", (), {k: importlib.import_module(f"{pkg}.{k}") for k in ("guards", "forces", "cells")})
-             for pkg in (old_name, "solver")]
+             for pkg in names]
     s = simulation(a.case, a.ch, a.shifting, a.particles, a.warmup)
     for name, (call, outputs) in passes(s).items():
         for k in (0, 1):

@@ -8,7 +8,10 @@ both; CG from the explicit step, to the solver's tolerance) --calls times, the o
 every call, and prints the median ms of each, their ratio, the stages or CG iterations, and
 the largest difference of the two results over the largest |delta / dt|.
 
-Usage: python benchmarks/viscous_update.py OLD_TREE [--update substepped|implicit] [--dp 0.00025] [--ch 1.8]
+Both trees (NEW_TREE: default this one) are imported as copies (``benchmarks/pair_loop.py``:
+a copy against the tree imported as ``solver`` read 7-8 % slower for identical code).
+
+Usage: python benchmarks/viscous_update.py OLD_TREE [NEW_TREE] [--update substepped|implicit] [--dp 0.00025] [--ch 1.8]
            [--threads 2] [--warmup 4] [--calls 20]
 """
 from __future__ import annotations
@@ -41,6 +44,7 @@ def simulation(dp: float, ch: float, update: str, warmup: int):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("old_tree", type=Path)
+    ap.add_argument("new_tree", type=Path, nargs="?", default=Path(__file__).resolve().parents[1])
     ap.add_argument("--update", choices=["substepped", "implicit"], default="substepped")
     ap.add_argument("--dp", type=float, default=0.00025)
     ap.add_argument("--ch", type=float, default=1.8)
@@ -52,6 +56,8 @@ def main(argv=None):
     from solver import implicit
     import_tree(a.old_tree, "solver_old")
     old_implicit = importlib.import_module("solver_old.implicit")
+    import_tree(a.new_tree, "solver_new")
+    new_implicit = importlib.import_module("solver_new.implicit")
     sim, kept = simulation(a.dp, a.ch, a.update, a.warmup)
     n, dt = sim.n_active, kept["dt"]
     diag = sim.out[sim.nq - 1]
@@ -89,7 +95,7 @@ def main(argv=None):
             return s, float(np.hypot(ax[:n][fluid], az[:n][fluid]).max(initial=0.0))
         return run
 
-    run_old, run_new = runner(old_implicit), runner(implicit)
+    run_old, run_new = runner(old_implicit), runner(new_implicit)
     runs = {"old": run_old, "new": run_new}
     times = {"old": [], "new": []}
     results = {}
