@@ -1,6 +1,8 @@
 """The step's passes other than the pair loop, of two solver trees, on the same arrays: us per call.
 
-Times the guards' pass (``guards.fluid_health``), the accumulators' reduction
+Times the mDBC update of the wall particles (``boundary.make_mdbc_update``, with the scene's
+ghost velocity; on copies of rho, u, w, so that every call starts from the same state), the
+guards' pass (``guards.fluid_health``), the accumulators' reduction
 (``forces.reduce_accumulators``), the cell assignment (``cells.assign_cells``) and the counting
 sort (``cells.counting_sort``) of OLD_TREE and NEW_TREE (default: this tree), each imported as
 a copy (as ``benchmarks/pair_loop.py`` does: a copy against the tree imported as ``solver``
@@ -58,7 +60,18 @@ def passes(s) -> dict:
     order = [np.zeros_like(s.order), np.zeros_like(s.order)]
     start = [np.zeros_like(s.start), np.zeros_like(s.start)]
     sorted_cell = s.cell.copy()
-    return {
+    walls = [tuple(a.copy() for a in (s.u, s.w, s.rho)) for _ in range(2)]
+
+    def mdbc(m, k):
+        u, w, rho = walls[k]
+        u[:], w[:], rho[:] = s.u, s.w, s.rho
+        m.boundary.make_mdbc_update(s.scene.physics.mdbc_velocity == "corrected",
+                                    bool(s.scene.physics.no_penetration))(
+            s.x, s.z, u, w, rho, s.mass, s.kind, s.wall, s.gx, s.gz, s.wall_velocities(s.t), s.cells,
+            s.n_active, s.h, s.rho0, s.scene.dp ** 2, s.n_lattice)
+
+    passes = {} if not s.mdbc else {"mdbc_update": (mdbc, [np.concatenate(a) for a in walls])}
+    return passes | {
         "fluid_health": (lambda m, k: m.guards.fluid_health(
             s.x, s.z, s.u, s.w, s.rho, s.mass, s.kind, s.n_active, s.rho0, s.walls, g.periodic, g.x0,
             g.period, health[k]), health),
@@ -91,7 +104,8 @@ def main(argv=None):
     numba.set_num_threads(a.threads)
     names = [import_tree(tree.resolve(), name).__name__ for tree, name in ((a.old, "solver_old"),
                                                                           (a.new, "solver_new"))]
-    trees = [type("tree", (), {k: importlib.import_module(f"{pkg}.{k}") for k in ("guards", "forces", "cells")})
+    trees = [type("tree", (), {k: importlib.import_module(f"{pkg}.{k}")
+                               for k in ("guards", "forces", "cells", "boundary")})
              for pkg in names]
     s = simulation(a.case, a.ch, a.shifting, a.particles, a.warmup)
     for name, (call, outputs) in passes(s).items():

@@ -107,6 +107,7 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
         fac = grad_coefficient(h)
         periodic, period, x0 = cl.periodic, cl.period, cl.x0
         four_h2 = 4.0 * h * h
+        inv_h = 1.0 / h
         for i in nb.prange(n_active):
             if kind[i] != 1:
                 continue
@@ -144,7 +145,7 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
                     r2 = dx * dx + dz * dz
                     if r2 >= four_h2:
                         continue
-                    q = math.sqrt(r2) / h
+                    q = math.sqrt(r2) * inv_h
                     Wv = w_value(q, alpha)
                     F = grad_factor(q, fac)
                     V = mass[j] / rho[j]
@@ -153,8 +154,8 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
                     gzv = F * dz * V
                     # r_j - r_g = -(dx, dz); unknown gradient scaled by h
                     a00 += WV
-                    a01 -= dx * WV / h
-                    a02 -= dz * WV / h
+                    a01 -= dx * WV * inv_h
+                    a02 -= dz * WV * inv_h
                     a10 += gxv * h
                     a11 -= gxv * dx
                     a12 -= gxv * dz
