@@ -183,6 +183,7 @@ def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, near, nx, nz
     (i itself included), n_j = -gradC_j / |gradC_j| their outward normals; zero where there is
     none. Scattered from the surface particles, which are few: serial."""
     four_h2 = 4.0 * h * h
+    inv_h = 1.0 / h
     for i in range(n_active):
         near[i] = 0
         nx[i] = 0.0
@@ -207,7 +208,7 @@ def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, near, nx, nz
                     r2 = ex * ex + ez * ez
                     if r2 < four_h2:
                         near[i] = 1
-                        s = 1.0 - 0.5 * math.sqrt(r2) / h
+                        s = 1.0 - 0.5 * math.sqrt(r2) * inv_h
                         wgt = s * s * s * s
                         nx[i] += wgt * ox
                         nz[i] += wgt * oz
