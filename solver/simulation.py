@@ -11,8 +11,8 @@ from .build import Particles, build_particles
 from .kernel import alpha_2d
 from .scene import Scene
 
-_SORTED = ("x", "z", "u", "w", "rho", "mass", "cell_volume", "drho_prev", "kind", "wall", "gx", "gz",
-           "wnx", "wnz", "pid")
+_SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "pid")
+_SHIFTING = ("cell_volume", "wnx", "wnz")  # read by the shifting sums alone
 _SHIFT = ("shift_dx", "shift_dz")  # the last shift, pending its density correction
 _IMPLICIT = ("implicit_cx", "implicit_cz")  # the last implicit correction, CG's next start
 
@@ -106,7 +106,7 @@ class Simulation:
             viscous_scale=self.viscous_normalisation)
         self.pair_loop = forces.make_pair_loop(**self.pair_options)
         self.substeps = s.viscous_substeps  # RKC stages rather than CG (no CG start to carry)
-        self.sorted_fields = (_SORTED + (_SHIFT if self.correct_shift else ())
+        self.sorted_fields = (_SORTED + (_SHIFTING if shifting_on else ()) + (_SHIFT if self.correct_shift else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
                               + (("viscous_scale",) if self.viscous_normalisation else ())
@@ -408,7 +408,7 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFT + _IMPLICIT + ("nu_p", "gamma_p", "viscous_scale", "nu_max_now", "t", "steps",
+    _STATE = _SORTED + _SHIFTING + _SHIFT + _IMPLICIT + ("nu_p", "gamma_p", "viscous_scale", "nu_max_now", "t", "steps",
                                              "info", "dt_first", "n_active", "reason")
 
     def state(self) -> dict:
