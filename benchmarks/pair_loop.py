@@ -9,7 +9,9 @@ weigh on both alike (whole steps of two simulations in one process do not: the o
 first runs faster). Both are copies because a copy's loop ran 7-8 % slower than the same code
 imported as ``solver`` (identical trees read 0.92-0.93 new/old when only OLD_TREE was copied,
 1.00 with both copied). The first call's summed accumulators of the two are compared
-(round-off only). One JSON line per configuration.
+(round-off only), and so is their machine code ("same_machine_code": the two compiled loops'
+assembly with symbol and label names taken out; identical trees give true, and still differed
+by 7-8 % in speed when one was the tree imported as ``solver``). One JSON line per configuration.
 
 Usage: python benchmarks/pair_loop.py OLD_TREE [NEW_TREE] [--ch 1.5 1.8] [--shifting none skillen lind]
            [--threads 2] [--calls 60] [--physics KEY=VALUE ...] [--jitter 0 0.05]
@@ -24,6 +26,7 @@ import argparse
 import importlib
 import inspect
 import json
+import re
 import shutil
 import sys
 import tempfile
@@ -45,6 +48,16 @@ def import_tree(tree: Path, name: str):
     shutil.copytree(tree / "solver", tmp / name, ignore=shutil.ignore_patterns("__pycache__"))
     sys.path.insert(0, str(tmp))
     return importlib.import_module(name)
+
+
+def machine_code(loop) -> str:
+    """The assembly of a pair loop's thread kernel, symbol, label and constant names taken out
+    (they differ between two packages of the same code), directives and comments dropped."""
+    kernel = loop.py_func.__globals__["_thread_pairs"]
+    text = "\n".join(kernel.inspect_asm().values())
+    text = re.sub(r"\.LBB\d+_\d+", "LABEL", re.sub(r"\.LCPI\d+_\d+", "CONST", re.sub(r"_ZN[\w$.]+", "SYMBOL", text)))
+    return "\n".join(line for line in text.splitlines()
+                     if line.strip() and not line.strip().startswith(("#", ".")))
 
 
 def measure(old_forces, new_forces, ch: float, shifting: str, calls: int, warmup: int, particles: int,
@@ -91,7 +104,8 @@ def measure(old_forces, new_forces, ch: float, shifting: str, calls: int, warmup
             "particles": s.n,
             "calls": calls, "old_ms": round(float(np.median(old)), 3), "new_ms": round(float(np.median(new)), 3),
             "new_over_old": round(float(np.median(new) / np.median(old)), 3),
-            "max_rel_difference": float((np.abs(sums[1] - sums[0]).max(axis=0) / np.where(scale > 0, scale, 1)).max())}
+            "max_rel_difference": float((np.abs(sums[1] - sums[0]).max(axis=0) / np.where(scale > 0, scale, 1)).max()),
+            "same_machine_code": machine_code(loops[0][0]) == machine_code(loops[1][0])}
 
 
 def main(argv=None):
