@@ -104,6 +104,7 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_eight_realisation
     ({"ensemble": {"realisations": 0}}, "ensemble.realisations"),
     ({"ensemble": {"realisations": 2.5}}, "ensemble.realisations"),
     ({"ensemble": {"perturbation": 0.5}}, "ensemble.perturbation"),
+    ({"ensemble": {"window_stagger": -0.5}}, "ensemble.window_stagger"),
     ({"case": {"shifting": "lind"}}, "case"),
     ({"case_overrides": [{"where": {"dp": 0.001}, "case": {"ch": 1.5}}]}, "case_overrides.0.case"),
     ({"grid": {"dp": [0.001], "ch": [1.8], "shifting": ["lind"], "exclude": [{"ch": 1.8}]}}, "grid.exclude"),
@@ -145,7 +146,7 @@ def test_command_line_strings_read_as_the_schema_types():
     c = load("config.yaml")
     c.update(ensemble={"realisations": "4", "perturbation": "1e-3"}, figures={"dpi": "90"})
     cfg = cfgmod.validate(c)
-    assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001, "overrides": []}
+    assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001, "overrides": [], "window_stagger": 0.0}
     assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40
     schema = cfgmod.load_schema()
     assert cfgmod.coerce_scalars({"warm_start": "True"}, schema) == {"warm_start": True}
@@ -516,7 +517,28 @@ def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
     assert (d["start_perturbation"], d["perturbation_seed"]) == (1.0e-5, 2)
     assert "start_perturbation" not in case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])
     assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_r1"]).id == "dp3mm_ch1.5_lind_r1"
-    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-3, "overrides": []}
+    assert validate(base)["ensemble"] == {"realisations": 1, "perturbation": 1.0e-3, "overrides": [],
+                                          "window_stagger": 0.0}
+    assert "min_time" not in case_dict(cfg, by_id["dp3mm_ch1.5_lind_r2"]).get("steady", {})
+
+
+def test_staggered_realisations_open_their_windows_later():
+    """ensemble.window_stagger: realisation k's steady.min_time is the case's plus k times the
+    stagger (the solver's default where the case sets none); realisation 0 and extra cases keep
+    the case's, so that realisation 0's run is the unstaggered case's."""
+    from solver.conveyor import Steady
+    from study.config import case_dict, cases, validate
+    base = {"grid": {"dp": [0.002], "ch": [1.5], "shifting": ["lind"]},
+            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}]}
+    ens = {"realisations": 3, "window_stagger": 0.25}
+    by_id = {c.id: c for c in cases(validate({**base, "case": {"steady": {"min_time": 2.0}}, "ensemble": ens}))}
+    cfg = validate({**base, "case": {"steady": {"min_time": 2.0}}, "ensemble": ens})
+    assert [case_dict(cfg, by_id[f"dp2mm_ch1.5_lind{r}"])["steady"]["min_time"] for r in ("", "_r1", "_r2")] \
+        == [2.0, 2.25, 2.5]
+    assert case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])["steady"]["min_time"] == 2.0
+    plain = validate({**base, "case": {}, "ensemble": ens})
+    assert case_dict(plain, by_id["dp2mm_ch1.5_lind_r2"])["steady"]["min_time"] == Steady().min_time + 0.5
+    assert "steady" not in case_dict(plain, by_id["dp2mm_ch1.5_lind"])
 
 
 def test_ensemble_overrides_set_the_realisations_of_some_grid_points():

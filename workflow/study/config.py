@@ -191,12 +191,22 @@ def case_dict(cfg: dict, case: Case) -> dict:
     d.update(name=case.id, dp=case.dp, ch=case.ch, shifting=case.shifting)
     if case.realisation:
         d.update(start_perturbation=cfg["ensemble"]["perturbation"], perturbation_seed=case.realisation)
+        stagger = cfg["ensemble"]["window_stagger"]
+        if stagger:  # realisation k's window k * stagger later (ensemble.window_stagger)
+            steady = d.setdefault("steady", {})
+            steady["min_time"] = steady.get("min_time", default_min_time()) + case.realisation * stagger
     for cfg_path, case_path in SOLVER_KEYS.items():  # the metrics read what the runs probed
         node = d
         for key in case_path[:-1]:
             node = node.setdefault(key, {})
         node[case_path[-1]] = copy.deepcopy(_get(cfg, cfg_path))
     return d
+
+
+def default_min_time() -> float:
+    """The solver case's steady.min_time where a campaign does not set it."""
+    from solver.conveyor import Steady
+    return Steady().min_time
 
 
 def _get(tree: dict, path: tuple):
