@@ -77,7 +77,8 @@ def test_configs_validate_and_expand():
 
 def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_eight_realisations():
     """config/accuracy.yaml: realisation 0 of each case has the default campaign's case file
-    exactly (so that a finished default run is kept), the others its perturbed starts."""
+    exactly (so that a finished default run is kept), the others its perturbed starts with
+    their windows staggered by 0.25 s (``ensemble.window_stagger``)."""
     default = cfgmod.validate(load("config.yaml"))
     acc = cfgmod.validate(load("accuracy.yaml"))
     cs = cfgmod.cases(acc)
@@ -90,7 +91,9 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_eight_realisation
             assert d == base[c.id], c.id
         else:
             stem = c.id.rsplit("_r", 1)[0]
-            extra = {"name": c.id, "start_perturbation": 1e-3, "perturbation_seed": c.realisation}
+            extra = {"name": c.id, "start_perturbation": 1e-3, "perturbation_seed": c.realisation,
+                     "steady": {**base[stem]["steady"],
+                                "min_time": base[stem]["steady"]["min_time"] + 0.25 * c.realisation}}
             assert d == {**base[stem], **extra}, c.id
 
 
