@@ -107,6 +107,9 @@ def test_an_ensemble_campaign_says_what_its_grid_values_and_errors_are():
     ds.attrs.update(realisations=3, start_perturbation=1e-6)
     text = render(ds, [], "grid: {}")
     assert "every grid case ran in 3 realisations" in text and "start by up to 1e-06 dp" in text
+    assert "min_time is raised" not in text  # no stagger: nothing said
+    ds.attrs.update(window_stagger=0.25)
+    assert "realisation k's steady.min_time is raised by k &times; 0.25 s" in render(ds, [], "grid: {}")
     n_points = ds["wall_time"].size
     assert f"{ds.sizes['case']} cases ({n_points} grid points; every grid case ran in 3 realisations)" in text
     assert "cheapest steady grid point &le; 0.01" in text

@@ -77,6 +77,7 @@ def cmd_reduce(a):
                     config_yaml=yaml.safe_dump(cfg, sort_keys=False),
                     realisations=int(ds["realisations"].max()),
                     start_perturbation=float(cfg["ensemble"]["perturbation"]),
+                    window_stagger=float(cfg["ensemble"]["window_stagger"]),
                     version_numba=str(runs[0].attrs.get("version_numba", "")))
     write_atomic(ds, a.output)
 

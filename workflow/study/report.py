@@ -256,9 +256,13 @@ def ensemble_paragraph(ds: xr.Dataset) -> str:
     if ensemble_size(ds) <= 1:
         return ""
     amp = float(ds.attrs.get("start_perturbation", np.nan))
+    stagger = float(ds.attrs.get("window_stagger", 0.0))
+    later = (f", and realisation k's steady.min_time is raised by k &times; {stagger:g} s, so that "
+             "its averaging window opens later and the windows sample a motion the runs share rather "
+             "than one phase of it") if stagger > 0 else ""
     return (f"<p><b>Ensemble:</b> {ensemble_counts(ds)}. Realisation 0 is the case as configured, "
             f"the others move each fluid particle's start by up to {amp:g} dp (ids ending in _r1, "
-            "_r2, ...; all in the case table). A grid point's metrics are the means over its "
+            f"_r2, ...; all in the case table){later}. A grid point's metrics are the means over its "
             "n realisations, and its se is sqrt(max(s<sup>2</sup>, mean se<sub>i</sub><sup>2</sup>) / n) "
             "(a single run's: its window's se): s, the realisations' spread, holds what one "
             "window's se misses; the windows' own se bound it from below. A grid point counts as "
