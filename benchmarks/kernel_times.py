@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import importlib
 import sys
 import time
 from pathlib import Path
@@ -51,9 +52,7 @@ def main(argv=None):
     ap.add_argument("--rows", type=int, default=16)
     a = ap.parse_args(argv)
     numba.set_num_threads(a.threads)
-    import importlib
-
-    import solver
+    import solver  # before step_passes, which puts this tree first on sys.path
     from step_passes import simulation
     sim = simulation(a.case, a.ch, a.shifting, a.particles, a.warmup, a.set)
     times = collections.defaultdict(float)

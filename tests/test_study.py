@@ -534,8 +534,8 @@ def test_staggered_realisations_open_their_windows_later():
     base = {"grid": {"dp": [0.002], "ch": [1.5], "shifting": ["lind"]},
             "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}]}
     ens = {"realisations": 3, "window_stagger": 0.25}
-    by_id = {c.id: c for c in cases(validate({**base, "case": {"steady": {"min_time": 2.0}}, "ensemble": ens}))}
     cfg = validate({**base, "case": {"steady": {"min_time": 2.0}}, "ensemble": ens})
+    by_id = {c.id: c for c in cases(cfg)}
     assert [case_dict(cfg, by_id[f"dp2mm_ch1.5_lind{r}"])["steady"]["min_time"] for r in ("", "_r1", "_r2")] \
         == [2.0, 2.25, 2.5]
     assert case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])["steady"]["min_time"] == 2.0
