@@ -75,14 +75,14 @@ def test_configs_validate_and_expand():
     assert {c.ch for c in cs if c.shifting == "lind"} == {1.8}
 
 
-def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_eight_realisations():
+def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisations():
     """config/accuracy.yaml: realisation 0 of each case has the default campaign's case file
     exactly (so that a finished default run is kept), the others its perturbed starts with
     their windows staggered by 0.25 s (``ensemble.window_stagger``)."""
     default = cfgmod.validate(load("config.yaml"))
     acc = cfgmod.validate(load("accuracy.yaml"))
     cs = cfgmod.cases(acc)
-    assert len(cs) == 16 and {c.realisation for c in cs} == set(range(8))
+    assert len(cs) == 32 and {c.realisation for c in cs} == set(range(16))
     assert {(c.dp, c.ch) for c in cs} == {(0.001, 1.8)} and {c.shifting for c in cs} == {"skillen", "lind"}
     base = {c.id: cfgmod.case_dict(default, c) for c in cfgmod.cases(default) if c.dp == 0.001}
     for c in cs:
@@ -373,7 +373,7 @@ def dry_run(configfile, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18), ("accuracy.yaml", 16),
+@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18), ("accuracy.yaml", 32),
                                      ("stability.yaml", 22), ("viscoplastic.yaml", 6)])
 def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     counts = dry_run(ROOT / "config" / name, tmp_path)
