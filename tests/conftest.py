@@ -29,15 +29,6 @@ def example_scene(name: str, **changes):
     return scene_from_dict(merge(example_dict(name), changes))
 
 
-def load_benchmark(name: str):
-    """The module benchmarks/NAME.py (the benchmarks are scripts, not a package)."""
-    import importlib.util
-    spec = importlib.util.spec_from_file_location(name, EXAMPLES.parent / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def periodic_layer(ch: float, physics: dict, viscosity: float = 1.0e-3):
     """A periodic fluid layer 40 dp deep and long (dp = 1 mm, rho0 = 1000, c0 = 10, no gravity)
     on a 4 dp bed, at rest, sorted into its cells by one evaluation."""

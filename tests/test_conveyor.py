@@ -15,7 +15,7 @@ from solver import lubrication
 from solver.build import build_particles
 from solver.conveyor import build_scene, case_from_dict, initial_toe, scheme_fluid, wall_thickness
 from solver.scene import SceneError
-from tests.conftest import EXAMPLES, coarse_conveyor_case, load_benchmark, worst_density_deviation
+from tests.conftest import EXAMPLES, coarse_conveyor_case, worst_density_deviation
 
 
 def paper(**changes):
@@ -142,22 +142,6 @@ def test_fast_example_is_the_paper_case_with_its_documented_settings():
     assert (fast.viscous_normalisation, fast.mdbc_velocity) == (True, "corrected")
     assert fast.h_n == paper().h_n
     build_scene(replace(fast, dp=4.0e-3, ch=1.5))
-
-
-def test_time_to_solution_runs_the_fast_example_as_shipped():
-    """benchmarks/time_to_solution.py's ``fast_average_1s`` (issue 9's time to a steady
-    answer) runs examples/conveyor.yaml with overrides: they must give the fast example's case,
-    its steady block included (its min_time 2 s, not conveyor.yaml's default 4 s), but for the
-    name. ``fast`` keeps conveyor.yaml's 2 s average and nothing else of it."""
-    from solver.cli import apply_overrides
-    tts = load_benchmark("time_to_solution")
-    with open(EXAMPLES / "conveyor_fast.yaml") as fh:
-        fast_d = yaml.safe_load(fh)
-    for variant, average in (("fast_average_1s", 1.0), ("fast", 2.0)):
-        with open(EXAMPLES / "conveyor.yaml") as fh:
-            d = apply_overrides(yaml.safe_load(fh), ["shifting=skillen"] + tts.VARIANTS[variant])
-        want = dict(fast_d, name=d["name"], steady=dict(fast_d["steady"], average=average))
-        assert case_from_dict(d) == case_from_dict(want), variant
 
 
 def test_case_errors_name_the_key():
@@ -389,11 +373,11 @@ def test_a_start_perturbation_moves_each_point_by_at_most_its_amplitude_and_is_s
 
 
 def test_toe_profile_theory_keeps_the_stations_and_the_flux():
-    """benchmarks/toe_profile.py: the lubrication front's second-order long-wave correction of
+    """study/toe_profile.py: the lubrication front's second-order long-wave correction of
     the profile (the stations' depths are solver.lubrication's): zero on the belt, zero net flux
     (the depth-mean of u* stays 1), independent of the difference step, and nil in the
     uniform zone."""
-    tp = load_benchmark("toe_profile")
+    import study.toe_profile as tp
     s, d = tp.second_order_profile(0.76)
     assert d[0] == 0.0
     assert abs(np.trapezoid(d, s)) < 1e-6 and np.abs(d).max() > 1e-3

@@ -468,14 +468,13 @@ def test_zeta_f_of_the_front_body_reads_the_fronts_motion_not_the_toes_jumps():
     assert math.isnan(float(m.zeta_f_body)) and math.isnan(float(m.zeta_f_body_se))
 
 
-# ---- benchmarks/compare_campaigns.py ----------------------------------------------------
+# ---- study/compare.py --------------------------------------------------------------------
 def test_compare_campaigns_measures_changes_in_combined_standard_errors():
     """z = (new - old) / sqrt(se_new^2 + se_old^2), per case and metric: a zeta_h moved by
     3 se in both runs' units is z = 3 / sqrt(2), the only |z| above 2; others stay 0."""
     from campaign_data import campaign
     from test_verdict import paper_like
-    from tests.conftest import load_benchmark
-    cc = load_benchmark("compare_campaigns")
+    import study.compare as cc
     old = campaign(paper_like)
     for m in cc.METRICS:
         old[f"case_{m}_se"] = xr.full_like(old[f"case_{m}"], 0.001)
