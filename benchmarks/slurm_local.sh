@@ -4,13 +4,38 @@
 #
 #   sudo apt-get install -y slurm-wlm munge      # once
 #   bash benchmarks/slurm_local.sh [WORKDIR]      # as root (it writes /etc/slurm, starts daemons)
+#   bash benchmarks/slurm_local.sh --check        # what it needs, found or not; changes nothing
 #
 # No accounting database is set up: the executor plugin is told to poll job states with
 # squeue (--slurm-status-command squeue), and MinJobAge keeps finished jobs visible to it.
 # With slurmdbd and sacct a real cluster needs none of that.
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+PY="${PYTHON:-python}"
+cd "$ROOT" && "$PY" -m benchmarks.common  # date, host, commit
+
+if [ "${1:-}" = "--check" ]; then
+  echo "| needs | found |"
+  echo "|---|---|"
+  missing=0
+  for cmd in slurmctld slurmd munged sinfo squeue snakemake; do
+    where="$(command -v "$cmd" 2>/dev/null || ls "/usr/sbin/$cmd" 2>/dev/null || true)"
+    echo "| $cmd | ${where:-no} |"
+    [ -n "$where" ] || missing=$((missing + 1))
+  done
+  root="$([ "$(id -u)" -eq 0 ] && echo yes || echo no)"
+  echo "| root | $root |"
+  [ "$root" = yes ] || missing=$((missing + 1))
+  if [ "$missing" -eq 0 ]; then
+    echo "summary: ready for a SLURM run (bash benchmarks/slurm_local.sh)"
+  else
+    echo "summary: $missing of 7 needs missing: not run (sudo apt-get install -y slurm-wlm munge; run as root)"
+  fi
+  exit 0
+fi
+
 WORK="${1:-/tmp/sph-surge-slurm}"
+START=$SECONDS
 HOST="$(hostname -s)"
 CPUS="$(nproc)"
 MEM_MB="$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 - 1024 ))"
@@ -62,3 +87,4 @@ snakemake -s "$ROOT/Snakefile" --configfile "$ROOT/tests/data/mini.yaml" \
 echo "--- jobs (squeue, finished ones kept for MinJobAge):"
 squeue -t all -o "%.6i %.45k %.10T %.8M %.4C"
 ls -l "$WORK/reports/report.html"
+echo "summary: the miniature campaign through profiles/slurm in $((SECONDS - START)) s"
