@@ -80,18 +80,6 @@ def amplification(a, b, e, explicit_viscosity: bool = False) -> np.ndarray:
     return _matrices(a, b, e, rows)
 
 
-def leapfrog_amplification(a, b, e) -> np.ndarray:
-    """The leapfrog density update's step matrices (``density_update: leapfrog``) on the same
-    (rho, v, q = dt D^{n-1}): rho_h = rho^n + q / 2, v^{n+1} = exp(-b) v^n + a rho_h, the rate at
-    v^{n+1} q' = -a v^{n+1} - e rho_h, rho^{n+1} = rho_h + q' / 2."""
-    def rows(a, b, e):
-        damp, s = np.exp(-b), a * a + e
-        return ([1.0 - 0.5 * s, -0.5 * a * damp, 0.5 - 0.25 * s],
-                [a, damp, 0.5 * a],
-                [-s, -a * damp, -0.5 * s])
-    return _matrices(a, b, e, rows)
-
-
 def spectral_radius(m: np.ndarray) -> np.ndarray:
     return np.abs(np.linalg.eigvals(m)).max(axis=-1)
 

@@ -170,7 +170,7 @@ def _warm(args) -> int:
     def step_twice(case, boundary=None):
         d = build_scene(case).to_dict()
         if boundary:
-            d["physics"]["boundary"] = boundary
+            d["numerics"]["boundary"] = boundary
         sim = Simulation(scene_from_dict(d))
         for _ in range(2):
             sim.step()
@@ -180,7 +180,7 @@ def _warm(args) -> int:
     for shifting in ("none", "skillen", "lind"):
         for diffusion in (0.1, None):
             case = case_from_dict({"dp": 0.004, "ch": 1.5, "shifting": shifting,
-                                   "density_diffusion": diffusion})
+                                   "numerics": {"density_diffusion": diffusion}})
             for boundary in ("mdbc", "dbc"):
                 step_twice(case, boundary)
     seen = set()
@@ -193,7 +193,7 @@ def _warm(args) -> int:
         coarse = case_from_dict({**d, "dp": max(case.dp, case.h_n / 5)})
         scene = build_scene(coarse).to_dict()
         fluid = {k: v for k, v in scene["fluid"].items() if k not in ("blocks", "profiles")}
-        key = json.dumps([scene["physics"], fluid], sort_keys=True)  # what selects the kernels
+        key = json.dumps([scene["numerics"], fluid], sort_keys=True)  # what selects the kernels
         if key not in seen:
             seen.add(key)
             step_twice(coarse)

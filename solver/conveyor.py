@@ -9,13 +9,14 @@ fluid_length h_n h_s. The toe stands still in the lab frame at steady state.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import lubrication, viscoplastic
-from .scene import (CFL_RULES, DENSITY_UPDATES, NEAR_SURFACE, VISCOUS_UPDATES, Scene, SceneError, YamlData, parse_into,
+from . import lubrication, schemes, viscoplastic
+from .scene import (SHIFTING_METHODS, Numerics, Scene, SceneError, YamlData, _as_float, parse_into, refuse_moved_keys,
                     scene_from_dict)
 from .steady import SteadyCriteria
 
@@ -72,16 +73,10 @@ class ConveyorCase(YamlData):
     name: str = "conveyor"
     ch: float = 1.8
     shifting: str = "lind"
-    shifting_coefficient: float | None = None
-    shift_density_correction: bool | None = None  # null: the method's default
-    shift_correction_limit: float | None = None  # null: the method's default
-    shift_max: float | None = None  # clip of each shift component in dp; null: the scene default
-    # skillen: the shift's speed is max(|u|, shift_min_speed u_b) (0: SPEC's |u|); not used by
-    # the other methods, so that one campaign grid holds both
-    shift_min_speed: float = 0.0
-    # lind within 2h of the free surface: "none" (SPEC: no shift) or "tangential" (along the
-    # surface only); not used by the other methods, so that one campaign grid holds both
-    shift_near_surface: str = "none"
+    # the numerics preset (solver/schemes.py): surge, the shipped scheme, or spec, the paper's;
+    # ``numerics`` holds the resolved choices, the preset's with the case's own keys over them
+    scheme: str = schemes.DEFAULT_SCHEME
+    numerics: Numerics | None = None
     density: float = 1383.0
     viscosity: float = 5.6  # mu [Pa s] of a newtonian fluid (not used by herschel_bulkley)
     rheology: str = "newtonian"  # or herschel_bulkley (the scene's fluid keys below)
@@ -97,7 +92,9 @@ class ConveyorCase(YamlData):
     fluid_length: float = 20.0  # in h_n, of the initial block (the lubrication start keeps its area)
     start: str = "lubrication"
     start_depth: str = "film"  # lubrication start: film (the scheme's own normal depth) or theory
-    start_velocity: str = "rest"  # or lubrication: the steady film profile, belt running from t = 0
+    # rest, or lubrication: the steady film profile, belt running from t = 0 (a warm start takes
+    # its velocities from warm_from instead)
+    start_velocity: str = "rest"
     warm_from: str | None = None  # start: warm: a front run's NetCDF (another dp) to start from
     # a realisation of the run: every fluid particle's start position moved by up to
     # start_perturbation dp in x and in z (uniform, drawn with perturbation_seed); 0: none
@@ -106,24 +103,17 @@ class ConveyorCase(YamlData):
     wall_height: float = 2.5  # upstream wall, in h_n
     normalising_depth: float = 0.0186  # m: the paper's h_n used to normalise its data
     coefsound: float = 10.0
-    cfl: float = 0.2
-    cfl_viscous: float | None = None  # C of the viscous limit alone; null: cfl
-    cfl_rule: str = "fixed"  # damping: the acoustic C at most 0.85 times its damped edge (Scene.cfl_acoustic)
-    density_diffusion: float | None = 0.1
-    density_diffusion_reference: str = "spec"
-    viscous_correction: bool = False
-    viscous_normalisation: bool = False
-    volume_relaxation: float | None = None
-    viscous_update: str = "explicit"  # implicit or substepped: no viscous limit on dt; auto(_substepped): where it pays
-    density_update: str = "explicit"  # leapfrog: the density's second half step at v^{n+1}
-    no_tension: bool = False  # the fluid density floored at rho0 after each step (physics.no_tension)
-    boundary: str = "mdbc"
-    mdbc_velocity: str = "shepard"
     max_area_drift: float = 0.05  # guard: |enclosed / mass-implied area - 1|
     probes: Probes = field(default_factory=Probes)
     steady: Steady = field(default_factory=Steady)
     checkpoint_interval: float = 1.0  # s of simulated time
     memory_budget_gb: float = 4.0
+
+    def __post_init__(self):
+        if self.numerics is None:  # built in Python without numerics: the scheme's own
+            self.numerics = parse_into(Numerics, preset_numerics(self.scheme, self.belt.speed, self.newtonian),
+                                       "case.numerics")
+        self.numerics.shifting.method = self.shifting  # the grid's axis, recorded with the rest
 
     @property
     def theta(self) -> float:
@@ -172,12 +162,54 @@ class ConveyorCase(YamlData):
                               min_time=self.ramp_end + s.min_time, dp=self.dp)
 
 
+# flat numerics keys of an older case layout: where each lives now
+_NUMERICS_KEYS = ("cfl", "cfl_rule", "density_diffusion", "density_diffusion_reference", "viscous_correction",
+                  "volume_relaxation", "viscous_update", "no_tension", "boundary", "mdbc_velocity")
+MOVED_CASE_KEYS = {
+    **{k: f"now numerics.{k} (under the case's numerics: block)" for k in _NUMERICS_KEYS},
+    "shifting_coefficient": "now numerics.shifting.coefficient",
+    "shift_min_speed": "now numerics.shifting.min_speed, in m/s",
+    "shift_near_surface": "now numerics.shifting.near_surface",
+    "viscous_normalisation": "removed: numerics.viscous_correction corrects and normalises the laminar term",
+    "cfl_viscous": "removed: one C for the force and viscous limits (numerics.cfl)",
+    "density_update": "removed: the density is updated with the evaluation's rate",
+    "shift_density_correction": "removed: shifting always corrects the density for its volume change",
+    "shift_correction_limit": "removed: Lind's per-step limit is fixed (scene.LIND_CORRECTION_LIMIT)",
+    "shift_max": "removed: each shift component is clipped to 0.1 dp",
+}
+
+
+def preset_numerics(scheme: str, belt_speed: float, newtonian: bool = True) -> dict:
+    """The numerics block of scheme ``scheme`` (``schemes.preset``)."""
+    return schemes.preset(scheme, belt_speed, newtonian).get("numerics", {})
+
+
+def resolve_scheme(data: dict) -> dict:
+    """The case data with its scheme's preset under it (``schemes.preset``); SceneError for
+    an unknown scheme, a moved key or a shifting method set inside numerics."""
+    refuse_moved_keys(data, MOVED_CASE_KEYS, "case.")
+    name = data.get("scheme", schemes.DEFAULT_SCHEME)
+    if name not in schemes.SCHEMES:
+        raise SceneError(f"case.scheme: {name!r} is not one of {', '.join(schemes.SCHEMES)}")
+    numerics = data.get("numerics")
+    method = numerics.get("shifting", {}).get("method") if isinstance(numerics, dict) else None
+    if method is not None and method != data.get("shifting", ConveyorCase.shifting):
+        raise SceneError(f"case.numerics.shifting.method: {method!r}, but the case's shifting key, which "
+                         f"sets the method, is {data.get('shifting', ConveyorCase.shifting)!r}: set shifting only")
+    belt = data.get("belt") if isinstance(data.get("belt"), dict) else {}
+    speed = _as_float(belt.get("speed", Belt().speed), "case.belt.speed")
+    newtonian = data.get("rheology", ConveyorCase.rheology) == "newtonian"
+    return schemes.merge(schemes.preset(name, speed, newtonian), data)
+
+
 def case_from_dict(data) -> ConveyorCase:
-    steady = data.get("steady") if isinstance(data, dict) else None
+    if not isinstance(data, dict):
+        raise SceneError(f"case: expected a mapping, got {data!r}")
+    steady = data.get("steady")
     if isinstance(steady, dict) and "velocity" in steady:
         raise SceneError("case.steady.velocity: no longer a key; the steady detection holds each station's "
-                         "area to steady.front_velocity (docs/conveyor.md, 'Steady state and averaging')")
-    case = parse_into(ConveyorCase, data, "case")
+                         "area to steady.front_velocity (docs/conveyor.md)")
+    case = parse_into(ConveyorCase, resolve_scheme(data), "case")
     validate_case(case)
     return case
 
@@ -189,26 +221,14 @@ def validate_case(c: ConveyorCase) -> None:
             raise SceneError(f"{key}: must be a positive finite number, got {v!r}")
 
     for key in ("dp", "density", "viscosity", "gravity", "fluid_length", "wall_height",
-                "normalising_depth", "coefsound", "cfl", "max_area_drift", "checkpoint_interval"):
+                "normalising_depth", "coefsound", "max_area_drift", "checkpoint_interval"):
         positive(getattr(c, key), f"case.{key}")
-    if c.cfl_viscous is not None:
-        positive(c.cfl_viscous, "case.cfl_viscous")
-    if not (c.shift_min_speed >= 0 and math.isfinite(c.shift_min_speed)):
-        raise SceneError(f"case.shift_min_speed: must be a finite number >= 0 (a fraction of the belt "
-                         f"speed), got {c.shift_min_speed!r}")
-    if c.shift_near_surface not in NEAR_SURFACE:
-        raise SceneError(f"case.shift_near_surface: {c.shift_near_surface!r} is not one of "
-                         f"{', '.join(NEAR_SURFACE)}")
+    if c.scheme not in schemes.SCHEMES:
+        raise SceneError(f"case.scheme: {c.scheme!r} is not one of {', '.join(schemes.SCHEMES)}")
+    if c.shifting not in SHIFTING_METHODS:
+        raise SceneError(f"case.shifting: {c.shifting!r} is not one of {', '.join(SHIFTING_METHODS)}")
     if c.newtonian and c.strain_rate_correction:
         raise SceneError("case.strain_rate_correction: only for rheology herschel_bulkley")
-    if c.viscous_update not in VISCOUS_UPDATES:
-        raise SceneError(f"case.viscous_update: {c.viscous_update!r} is not one of "
-                         f"{', '.join(VISCOUS_UPDATES)}")
-    if c.cfl_rule not in CFL_RULES:
-        raise SceneError(f"case.cfl_rule: {c.cfl_rule!r} is not one of {', '.join(CFL_RULES)}")
-    if c.density_update not in DENSITY_UPDATES:
-        raise SceneError(f"case.density_update: {c.density_update!r} is not one of "
-                         f"{', '.join(DENSITY_UPDATES)}")
     if not 0 < c.slope_deg < 90:
         raise SceneError(f"case.slope_deg: must lie in (0, 90), got {c.slope_deg}")
     if c.start not in START_SHAPES:
@@ -216,9 +236,6 @@ def validate_case(c: ConveyorCase) -> None:
     if c.start_velocity not in START_VELOCITIES:
         raise SceneError(f"case.start_velocity: {c.start_velocity!r} is not one of "
                          f"{', '.join(START_VELOCITIES)}")
-    if c.start == "warm" and c.start_velocity != "rest":
-        raise SceneError("case.start_velocity: a warm start takes its velocities from warm_from; "
-                         "leave start_velocity at rest")
     if c.start_depth not in START_DEPTHS:
         raise SceneError(f"case.start_depth: {c.start_depth!r} is not one of {', '.join(START_DEPTHS)}")
     if not 0.0 <= c.start_perturbation <= MAX_PERTURBATION:
@@ -345,17 +362,6 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
         fluid = {"profiles": [{"x": [0.0, c.dp * math.floor(x_toe / c.dp)], "base": 0.0,
                                "surface": surface,
                                "row_depth": None if warm is not None else start.h_n}]}
-    shifting = {"method": c.shifting}
-    if c.shifting_coefficient is not None:
-        shifting["coefficient"] = c.shifting_coefficient
-    for key, value in (("density_correction", c.shift_density_correction),
-                       ("correction_limit", c.shift_correction_limit), ("max_shift", c.shift_max)):
-        if value is not None:
-            shifting[key] = value
-    if c.shift_min_speed and c.shifting == "skillen":
-        shifting["min_speed"] = c.shift_min_speed * c.belt.speed
-    if c.shifting == "lind":
-        shifting["near_surface"] = c.shift_near_surface
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,
@@ -368,17 +374,7 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
         ] + taper,
         "gravity": [g * math.sin(th), -g * math.cos(th)],
         "sound": {"coefsound": c.coefsound, "depth": hn},
-        "cfl": c.cfl,
-        "cfl_viscous": c.cfl_viscous,
-        "cfl_rule": c.cfl_rule,
-        "physics": {"boundary": c.boundary, "mdbc_velocity": c.mdbc_velocity,
-                    "density_diffusion": c.density_diffusion,
-                    "density_diffusion_reference": c.density_diffusion_reference,
-                    "viscous_correction": c.viscous_correction,
-                    "viscous_normalisation": c.viscous_normalisation,
-                    "volume_relaxation": c.volume_relaxation,
-                    "viscous_update": c.viscous_update, "density_update": c.density_update,
-                    "no_tension": c.no_tension, "shifting": shifting},
+        "numerics": dataclasses.asdict(c.numerics),
         "time": {"end": c.steady.max_time, "output_interval": c.steady.max_time,
                  "diagnostics_interval": max(c.probes.interval, 0.01)},
         "memory_budget_gb": c.memory_budget_gb,

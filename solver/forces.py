@@ -1,4 +1,4 @@
-"""The pair loop (SPEC section 6): continuity with Fourtakas diffusion, pressure,
+"""The pair loop (docs/scheme.md section 6): continuity with Fourtakas diffusion, pressure,
 Lo & Shao laminar viscosity, and the shifting sums, over a half stencil.
 
 Fluid-wall pairs never attract: their P_a + P_b is floored at zero. A fluid in suction next
@@ -9,18 +9,15 @@ Each pair (a, b) is visited once (b after a in a's grid column, or in the next c
 within 2h of a in z: two ranges of the z-sorted columns, ``cells``) and its contributions are
 added to both particles, into per-thread accumulators ``acc[t, i, q]`` (no write races; the
 slots of one particle share a cache line), reduced afterwards; a's sums stay in registers
-over the b loop. For each a the candidates b are first listed without a branch (each one
-written, the count advanced only for those within 2h and not wall-wall), then the pair terms
-run over that list: in a flowing arrangement the 2h test fails for about half the candidates
-at random, and a branch per candidate then mispredicts (benchmarks/pair_loop.py --jitter).
-Slots q (named below): ax, az, drho/dt; with shifting gradC_x, gradC_z, div r and the
-kernel-weighted sum of the inward normals of nearby wall particles (where shifting must not
-push); with the shifting density correction, div(dr) of the previous step's shift.
-Density diffusion, the shifting sums and div(dr) are compiled in or out (``make_pair_loop``).
+over the b loop (a tuple, ``add``). For each a the candidates b are first listed without a
+branch (each one written, the count advanced only for those within 2h and not wall-wall), then
+the pair terms run over that list: in a flowing arrangement the 2h test fails for about half
+the candidates at random, and a branch per candidate then mispredicts. The slots q are
+declared in SLOT_GROUPS; what a scene does not use is compiled out (``PairOptions``).
 
   drho_a/dt = rho_a sum_b u_ab.gradW_ab V_b + h c0 D_a
   D_a = 2 delta sum_b ((rho_a - rho_b) - rho_ab^H) (r_ab.gradW_ab) / (r^2 + eta^2) V_b
-  rho_ab^H (reference "spec") = rho0 ((1 + rho0 g_n (z_b - z_a) / B)^(1/7) - 1), as SPEC prints it;
+  rho_ab^H (reference "spec") = rho0 ((1 + rho0 g_n (z_b - z_a) / B)^(1/7) - 1), as the paper prints it;
   rho_ab^H (reference "column") = rho0 g_n (z_b - z_a) / c0^2 (rho0 / rho_m)^5, rho_m = (rho_a + rho_b)/2:
   the Tait column at rest (d rho/dz = -rho0^6 g_n / (c0^2 rho^5), g_n > 0) by the midpoint
   rule, antisymmetric in a and b and with no residual on such a column (docs/numerics.md)
@@ -43,49 +40,57 @@ from typing import NamedTuple
 
 import numba as nb
 import numpy as np
+from numba.cpython.unsafe.tuple import tuple_setitem
 
 from .kernel import ETA2, alpha_2d, grad_coefficient, grad_factor, w_value
 
-# Accumulator slots of the pair loop, acc[thread, particle, slot]
-AX, AZ, DRHO = 0, 1, 2                # acceleration, drho/dt
-GCX, GCZ, DIVR = 3, 4, 5              # shifting: gradC and div r
-WNX, WNZ = 6, 7                       # shifting: kernel-weighted inward wall normals
-DIVDR = 8                             # shifting density correction: div(dr) of the last shift
-# consistent viscous term: sum_b V_b gradW_ab, sum_b V_b (u_b - u_a) gradW_ab, div r with m/rho
-VGX, VGZ, DUX, DUZ, DWX, DWZ, VDIVR = 9, 10, 11, 12, 13, 14, 15
-NQ_BASE, NQ_SHIFT, NQ_CORRECTED, NQ_VISCOUS = 3, 8, 9, 16
-# corrected strain rate: the Laplacian of the last strain rate, and the support sum_b V_b (-F r^2) / 2
-LAPG, SUPP, NQ_STRAIN = 16, 17, 18
-# volume relaxation: the concentration sum_b V_b W_ab (without the self term) in the slot after
-# the others (``volume_slot``); the laminar term's normaliser N (viscous_scale) in the slot after
-# that; implicit viscosity: the diagonal sum_b c_ab of the backward-Euler system in the last slot
+# ---- accumulator slots ------------------------------------------------------------------
+# The pair sums of particle i are acc[thread, i, slot]. A loop variant holds the groups whose
+# switch is on, in this order (``slot_layout``); this table is where every slot is declared.
+SLOT_GROUPS = (
+    ("always", ("AX", "AZ", "DRHO")),  # acceleration, drho/dt
+    # packing: gradC, div r, the kernel-weighted inward normals of nearby wall particles (where
+    # shifting must not push), div(dr) of the last shift (its density correction)
+    ("packing", ("GCX", "GCZ", "DIVR", "WNX", "WNZ", "DIVDR")),
+    # consistent laminar term: sum_b V_b gradW_ab, div r with m/rho, the normaliser N
+    ("laminar_correction", ("VGX", "VGZ", "VDIVR", "NORM")),
+    ("velocity_gradient", ("DUX", "DUZ", "DWX", "DWZ")),  # sum_b V_b (u_b - u_a) gradW_ab
+    ("strain_correction", ("LAPG", "SUPP")),  # Laplacian of the last strain rate, the support
+    ("volume", ("VOLC",)),  # the volume relaxation's concentration sum_b V_b W_ab
+    ("implicit", ("DIAG",)),  # the diagonal sum_b c_ab of the implicit laminar system
+)
+Slots = NamedTuple("Slots", [(name, int) for _, names in SLOT_GROUPS for name in names] + [("nq", int)])
+AX, AZ, DRHO = 0, 1, 2  # present in every variant
 
 
-def n_slots(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
-            velocity_gradient: bool = False, implicit: bool = False,
-            strain_correction: bool = False, volume: bool = False, viscous_scale: bool = False) -> int:
-    nq = norm_slot(shifting, shift_correction, viscous_correction, velocity_gradient, strain_correction,
-                   volume) + (1 if viscous_scale else 0)
-    return nq + 1 if implicit else nq
+class PairOptions(NamedTuple):
+    """The pair loop's compile-time switches: one compiled loop per distinct value."""
+    diffusion: int = 0  # density diffusion: 0 off, 1 the paper's rho^H_ab, 2 the Tait column's
+    # 0 off; 1 the packing sums that shifting reads; 2 and the volume relaxation's concentration
+    packing: int = 0
+    laminar_correction: bool = False  # the consistent, normalised laminar term's sums
+    rheology: int = 0  # 0 one viscosity, 1 each particle's nu_p, 2 and the strain rate's Laplacian
+    artificial: bool = False  # Monaghan's artificial viscosity
+    implicit_walls: float = 0.0  # > 0: list the fluid pairs and sum the implicit diagonal
+
+    def groups(self) -> dict[str, bool]:
+        """Which slot groups of SLOT_GROUPS this variant sums."""
+        return {"always": True, "packing": self.packing >= 1,
+                "laminar_correction": self.laminar_correction,
+                "velocity_gradient": self.laminar_correction or self.rheology >= 1,
+                "strain_correction": self.rheology == 2, "volume": self.packing == 2,
+                "implicit": self.implicit_walls > 0.0}
 
 
-def volume_slot(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
-                velocity_gradient: bool = False, strain_correction: bool = False) -> int:
-    """The slot after the named ones: the volume relaxation's concentration when it is on."""
-    if strain_correction:
-        nq = NQ_STRAIN
-    elif viscous_correction or velocity_gradient:
-        nq = NQ_VISCOUS
-    else:
-        nq = NQ_CORRECTED if shift_correction else (NQ_SHIFT if shifting else NQ_BASE)
-    return nq
-
-
-def norm_slot(shifting: bool, shift_correction: bool, viscous_correction: bool = False,
-              velocity_gradient: bool = False, strain_correction: bool = False, volume: bool = False) -> int:
-    """The laminar normaliser's slot (``viscous_scale``): after the volume relaxation's."""
-    return volume_slot(shifting, shift_correction, viscous_correction, velocity_gradient,
-                       strain_correction) + (1 if volume else 0)
+def slot_layout(options: PairOptions) -> Slots:
+    """Each slot's index in this variant's accumulators (-1: not summed) and their number."""
+    index, nq = {}, 0
+    on = options.groups()
+    for group, names in SLOT_GROUPS:
+        for name in names:
+            index[name] = nq if on[group] else -1
+            nq += on[group]
+    return Slots(**index, nq=nq)
 
 
 class PairList(NamedTuple):
@@ -228,6 +233,17 @@ def artificial_factor(av, vdotr, inv_rsum, inv_r2e, F):
 
 
 @nb.njit(inline="always", cache=True)
+def pair_scale(sca, scb, ka, kb):
+    """The laminar factor of a pair: the mean of its two fluid particles' factors, or a
+    fluid-wall pair's fluid particle's (``viscous_scale_factors``)."""
+    if kb == 1:
+        return sca
+    if ka == 1:
+        return scb
+    return 0.5 * (sca + scb)
+
+
+@nb.njit(inline="always", cache=True)
 def diffusion_weight(delta, hc0, rdotg, inv_r2e):
     """g = 2 delta h c0 (r_ab . gradW_ab) / (r^2 + eta^2), the weight of D_a's pair term."""
     return 2.0 * delta * hc0 * rdotg * inv_r2e
@@ -259,37 +275,48 @@ def concentration_terms(F, dx, dz, rdotg):
     return F * dx, F * dz, -rdotg
 
 
+@nb.njit(inline="always", cache=True)
+def add(s, q, v):
+    """The running sums s (a tuple, kept in registers) with v added to slot q."""
+    return tuple_setitem(s, q, s[q] + v)
+
+
+@nb.njit(inline="always", cache=True)
+def add_pair(s, at, b, q, to_a, to_b):
+    """A pair's share of slot q: ``to_a`` to a's running sums s, ``to_b`` to b's row of at."""
+    at[b, q] += to_b
+    return tuple_setitem(s, q, s[q] + to_a)
+
+
 @functools.cache
-def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = False,
-                   column_reference: bool = False, viscous_correction: bool = False,
-                   artificial: bool = False, variable_viscosity: bool = False,
-                   implicit_walls: float = 0.0, strain_correction: bool = False,
-                   volume: bool = False, viscous_scale: bool = False):
-    """Compile the pair loop with density diffusion, the shifting sums and the shift's
-    divergence (for the density correction) in or out; ``column_reference`` picks the
-    diffusion's rho^H_ab ("column" rather than "spec"); ``viscous_correction`` adds the sums
-    of ``correct_viscous_term``; ``artificial`` adds Monaghan's artificial viscosity (all
-    pairs, walls included, as DualSPHysics); ``variable_viscosity`` takes each pair's
-    viscosity from the particles' nu_p (``pair_viscosity``) and sums the velocity gradient
-    into slots DUX..DWZ (``rheology``). ``implicit_walls`` > 0 (implicit viscosity,
-    ``solver.implicit``) lists the fluid pairs and their laminar weights (``PairList``) and sums
-    the diagonal sum_b m_b k_ab into the last slot, fluid-wall pairs weighted by
-    ``implicit_walls`` (2 for mDBC, 1 for DBC walls). ``strain_correction`` sums, over fluid
-    pairs, the Laplacian 2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate
-    g = ``f.gamma`` into LAPG and the support sum_b V_b (-F r^2) / 2 into SUPP (1 with a full
-    kernel, ``rheology.update_viscosity``). ``volume`` sums the concentration sum_b V_b W_ab
-    (every pair with a fluid particle) into slot ``volume_slot(...)``, for ``relax_density``.
-    ``viscous_scale`` multiplies each pair's laminar term by the mean of its two particles'
-    factors ``f.vscale`` (a fluid-wall pair by the fluid particle's) and sums the normaliser
-    N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)) into the slot after the volume's, for
-    ``viscous_scale_factors``."""
-    velocity_gradient = viscous_correction or variable_viscosity or strain_correction
+def make_pair_loop(options: PairOptions):
+    """Compile the pair loop for ``options`` (``PairOptions``), its slots ``slot_layout(options)``.
+
+    diffusion: D_a with the paper's rho^H_ab (1) or the Tait column's (2), fluid pairs only.
+    packing: gradC, div r and the wall normals into GCX..WNZ, the last shift's div(dr) into
+    DIVDR; at 2 also the concentration sum_b V_b W_ab (every pair with a fluid particle) into VOLC,
+    for ``packing.relax_density``. laminar_correction: the sums of ``correct_viscous_term`` and the
+    normaliser N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)) into NORM, and each pair's laminar term
+    times the mean of its two particles' factors ``f.vscale`` (a fluid-wall pair's by the fluid
+    particle's). rheology: each pair's viscosity from the particles' nu_p (``pair_viscosity``) and
+    the velocity gradient into DUX..DWZ (``rheology``); at 2 also the Laplacian
+    2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate g = ``f.gamma`` into LAPG
+    and the support sum_b V_b (-F r^2) / 2 into SUPP, over fluid pairs. artificial: Monaghan's
+    artificial viscosity (all pairs, walls included, as DualSPHysics). implicit_walls > 0: the
+    fluid pairs and their laminar weights listed (``PairList``) and the diagonal sum_b m_b k_ab
+    summed into DIAG, fluid-wall pairs weighted by implicit_walls (2 for mDBC, 1 for DBC walls)."""
+    o = options
+    diffusion, packing, rheology = o.diffusion, o.packing, o.rheology
+    laminar_correction, artificial, implicit_walls = o.laminar_correction, o.artificial, o.implicit_walls
     implicit = implicit_walls > 0.0
-    VOLC = volume_slot(shifting, shift_correction, viscous_correction, variable_viscosity,
-                       strain_correction)
-    NORM = norm_slot(shifting, shift_correction, viscous_correction, variable_viscosity, strain_correction,
-                     volume)
-    DIAG = NORM + 1 if viscous_scale else NORM
+    velocity_gradient = laminar_correction or rheology >= 1
+    sl = slot_layout(o)
+    NQ = sl.nq
+    ZERO = (0.0,) * NQ  # a's running sums, one per slot
+    GCX, GCZ, DIVR, WNX, WNZ, DIVDR = sl.GCX, sl.GCZ, sl.DIVR, sl.WNX, sl.WNZ, sl.DIVDR
+    VGX, VGZ, VDIVR, NORM = sl.VGX, sl.VGZ, sl.VDIVR, sl.NORM
+    DUX, DUZ, DWX, DWZ = sl.DUX, sl.DUZ, sl.DWX, sl.DWZ
+    LAPG, SUPP, VOLC, DIAG = sl.LAPG, sl.SUPP, sl.VOLC, sl.DIAG
 
     @nb.njit(cache=True, fastmath=FASTMATH)
     def thread_pairs(t, f, cl, split, k, acc, pair_i, pair_j, pair_k):
@@ -338,218 +365,149 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
             if has_next:
                 nx_lo = nx_hi = start[jx * ncz]
                 nx_end = start[(jx + 1) * ncz]
-            for iz in range(ncz):
-                ca = ix * ncz + iz
-                a0, a1 = start[ca], start[ca + 1]
-                if a0 == a1:
-                    continue
-                for a in range(a0, a1):
-                    xa, za, ua, wa = x[a], z[a], u[a], w[a]
-                    ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
-                    ira = irho[a]
-                    Va = ma * ira
-                    cell_a = f.cell[a]
-                    s_ax = s_az = s_drho = 0.0
-                    s_gcx = s_gcz = s_divr = s_wnx = s_wnz = s_divdr = 0.0
-                    s_vgx = s_vgz = s_dux = s_duz = s_dwx = s_dwz = s_vdivr = 0.0
-                    s_diag = 0.0
-                    s_lapg = s_supp = 0.0
-                    s_volc = 0.0
-                    s_norm = 0.0
-                    sca = 1.0
-                    if viscous_scale:
-                        sca = f.vscale[a]
-                    sxa = sza = 0.0
-                    if shift_correction:
-                        sxa, sza = f.sdx[a], f.sdz[a]
-                    z_lo, z_hi = za - two_h, za + two_h
-                    own_hi = max(own_hi, a + 1)
-                    while own_hi < col_end and z[own_hi] < z_hi:
-                        own_hi += 1
-                    while nx_lo < nx_end and z[nx_lo] <= z_lo:
-                        nx_lo += 1
-                    nx_hi = max(nx_hi, nx_lo)
-                    while nx_hi < nx_end and z[nx_hi] < z_hi:
-                        nx_hi += 1
-                    # the candidates within 2h (and not wall-wall), listed without a branch
-                    # (module docstring)
-                    n_near = 0
-                    for side in range(2):
-                        first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
-                        # unsigned: no negative-index wrap-around on the loads and stores of b
-                        for b in range(np.uint64(first), np.uint64(b1)):
-                            dx = xa - (x[b] + shift)
-                            dz = za - z[b]
-                            r2 = dx * dx + dz * dz
-                            near_b[n_near] = b
-                            near_dx[n_near] = dx
-                            near_dz[n_near] = dz
-                            near_r2[n_near] = r2
-                            n_near += (r2 < four_h2) & (ka + kind[b] != 2)
-                    for m in range(n_near):
-                        b = near_b[m]
-                        kb = kind[b]
-                        dx = near_dx[m]
-                        dz = near_dz[m]
-                        r2 = near_r2[m]
-                        q = math.sqrt(r2) * inv_h
-                        F = grad_factor(q, fac)
-                        rb = rho[b]
-                        du = ua - u[b]
-                        dw = wa - w[b]
-                        vdotr = du * dx + dw * dz
-                        rdotg = F * r2
-                        mb = mass[b]
-                        irb = irho[b]
-                        Vb = mb * irb
-                        inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
-                        ca, cb = continuity_terms(ra, rb, F, vdotr)
-                        s_drho += ca * Vb
-                        drho_b = cb * Va
-                        # momentum: pressure and laminar viscosity
-                        pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
-                        if variable_viscosity:
-                            nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
-                            vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
+            for a in range(start[ix * ncz], col_end):
+                xa, za, ua, wa = x[a], z[a], u[a], w[a]
+                ra, pa, ka, ma = rho[a], p[a], kind[a], mass[a]
+                ira = irho[a]
+                Va = ma * ira
+                cell_a = f.cell[a]
+                s = ZERO
+                sca = f.vscale[a] if laminar_correction else 1.0
+                sxa = sza = 0.0
+                if packing:
+                    sxa, sza = f.sdx[a], f.sdz[a]
+                z_lo, z_hi = za - two_h, za + two_h
+                own_hi = max(own_hi, a + 1)
+                while own_hi < col_end and z[own_hi] < z_hi:
+                    own_hi += 1
+                while nx_lo < nx_end and z[nx_lo] <= z_lo:
+                    nx_lo += 1
+                nx_hi = max(nx_hi, nx_lo)
+                while nx_hi < nx_end and z[nx_hi] < z_hi:
+                    nx_hi += 1
+                # the candidates within 2h (and not wall-wall), listed without a branch
+                # (module docstring)
+                n_near = 0
+                for side in range(2):
+                    first, b1, shift = (a + 1, own_hi, 0.0) if side == 0 else (nx_lo, nx_hi, next_shift)
+                    # unsigned: no negative-index wrap-around on the loads and stores of b
+                    for b in range(np.uint64(first), np.uint64(b1)):
+                        dx = xa - (x[b] + shift)
+                        dz = za - z[b]
+                        r2 = dx * dx + dz * dz
+                        near_b[n_near] = b
+                        near_dx[n_near] = dx
+                        near_dz[n_near] = dz
+                        near_r2[n_near] = r2
+                        n_near += (r2 < four_h2) & (ka + kind[b] != 2)
+                for m in range(n_near):
+                    b = near_b[m]
+                    kb = kind[b]
+                    dx = near_dx[m]
+                    dz = near_dz[m]
+                    r2 = near_r2[m]
+                    q = math.sqrt(r2) * inv_h
+                    F = grad_factor(q, fac)
+                    rb = rho[b]
+                    du = ua - u[b]
+                    dw = wa - w[b]
+                    vdotr = du * dx + dw * dz
+                    rdotg = F * r2
+                    mb = mass[b]
+                    irb = irho[b]
+                    Vb = mb * irb
+                    inv_r2e, inv_rsum = two_reciprocals(r2 + eta2, ra + rb)
+                    ca, cb = continuity_terms(ra, rb, F, vdotr)
+                    s = add(s, DRHO, ca * Vb)
+                    drho_b = cb * Va
+                    # momentum: pressure and laminar viscosity
+                    pt = pressure_factor(pa, p[b], ira, irb, F, ka + kb == 1)
+                    if rheology:
+                        nu_ab = pair_viscosity(f.nu_p[a], f.nu_p[b], ka + kb == 1, ka == 0)
+                        vt = laminar_factor(nu_ab, rdotg, inv_rsum, inv_r2e)
+                    else:
+                        vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
+                    if laminar_correction:
+                        vt *= pair_scale(sca, f.vscale[b], ka, kb)
+                        e = -0.5 * rdotg * r2 * inv_r2e
+                        s = add_pair(s, at, b, NORM, Vb * e, Va * e)
+                    if artificial:
+                        pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
+                    fx = -pt * dx + vt * du
+                    fz = -pt * dz + vt * dw
+                    s = add_pair(s, at, b, AX, mb * fx, -(ma * fx))
+                    s = add_pair(s, at, b, AZ, mb * fz, -(ma * fz))
+                    if implicit:  # k_ab = -vt
+                        if ka + kb == 0:
+                            if npl < cap:
+                                pair_i[t, npl] = a
+                                pair_j[t, npl] = b
+                                pair_k[t, npl] = -vt
+                            npl += 1
+                            s = add_pair(s, at, b, DIAG, -(mb * vt), -(ma * vt))
+                        elif kb == 1:
+                            s = add(s, DIAG, -(implicit_walls * mb * vt))
                         else:
-                            vt = laminar_factor(nu, rdotg, inv_rsum, inv_r2e)
-                        if viscous_scale:
-                            if kb == 1:
-                                vt *= sca
-                            elif ka == 1:
-                                vt *= f.vscale[b]
+                            at[b, DIAG] -= implicit_walls * ma * vt
+                    vr = abs(h * vdotr * inv_r2e)
+                    if vr > vm:
+                        vm = vr
+                    if diffusion:
+                        if ka + kb == 0:  # fluid pairs only
+                            g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
+                            if diffusion == 2:
+                                ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
+                                s = add(s, DRHO, ge * Vb)
+                                drho_b -= ge * Va
                             else:
-                                vt *= 0.5 * (sca + f.vscale[b])
-                            e = -0.5 * rdotg * r2 * inv_r2e
-                            s_norm += Vb * e
-                            at[b, NORM] += Va * e
-                        if artificial:
-                            pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
-                        fx = -pt * dx + vt * du
-                        fz = -pt * dz + vt * dw
-                        s_ax += mb * fx
-                        s_az += mb * fz
-                        at[b, AX] -= ma * fx
-                        at[b, AZ] -= ma * fz
-                        if implicit:  # k_ab = -vt
-                            if ka + kb == 0:
-                                if npl < cap:
-                                    pair_i[t, npl] = a
-                                    pair_j[t, npl] = b
-                                    pair_k[t, npl] = -vt
-                                npl += 1
-                                s_diag -= mb * vt
-                                at[b, DIAG] -= ma * vt
-                            elif kb == 1:
-                                s_diag -= implicit_walls * mb * vt
-                            else:
-                                at[b, DIAG] -= implicit_walls * ma * vt
-                        vr = abs(h * vdotr * inv_r2e)
-                        if vr > vm:
-                            vm = vr
-                        if diffusion:
-                            if ka + kb == 0:  # fluid pairs only
-                                g = diffusion_weight(k.delta, hc0, rdotg, inv_r2e)
-                                if column_reference:
-                                    ge = diffusion_column(g, ra - rb, dz, inv_rsum, rho0, k.k_col)
-                                    s_drho += ge * Vb
-                                    drho_b -= ge * Va
-                                else:
-                                    ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
-                                    s_drho += ea * Vb
-                                    drho_b += eb * Va
-                        at[b, DRHO] += drho_b
-                        if shifting:
-                            gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
-                            cell_b = f.cell[b]
-                            s_gcx += cell_b * gx
-                            s_gcz += cell_b * gz
-                            s_divr += cell_b * gdiv
-                            at[b, GCX] -= cell_a * gx
-                            at[b, GCZ] -= cell_a * gz
-                            at[b, DIVR] += cell_a * gdiv
-                            if kb == 1:
-                                s_wnx -= F * f.wnx[b]
-                                s_wnz -= F * f.wnz[b]
-                            elif ka == 1:
-                                at[b, WNX] -= F * f.wnx[a]
-                                at[b, WNZ] -= F * f.wnz[a]
-                        if viscous_correction:
-                            # gradW_ab = F r_ab; gradW_ba = -gradW_ab
-                            s_vgx += Vb * F * dx
-                            s_vgz += Vb * F * dz
-                            at[b, VGX] -= Va * F * dx
-                            at[b, VGZ] -= Va * F * dz
-                            s_vdivr -= Vb * rdotg
-                            at[b, VDIVR] -= Va * rdotg
-                        if velocity_gradient:
-                            # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
-                            s_dux -= Vb * du * F * dx
-                            s_duz -= Vb * du * F * dz
-                            s_dwx -= Vb * dw * F * dx
-                            s_dwz -= Vb * dw * F * dz
-                            at[b, DUX] -= Va * du * F * dx
-                            at[b, DUZ] -= Va * du * F * dz
-                            at[b, DWX] -= Va * dw * F * dx
-                            at[b, DWZ] -= Va * dw * F * dz
-                        if strain_correction:
-                            if ka + kb == 0:
-                                lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
-                                s_lapg += Vb * lg
-                                at[b, LAPG] -= Va * lg
-                                s_supp -= 0.5 * Vb * rdotg
-                                at[b, SUPP] -= 0.5 * Va * rdotg
-                        if volume:
-                            Wab = w_value(q, alpha)
-                            s_volc += Vb * Wab
-                            at[b, VOLC] += Va * Wab
-                        if shift_correction:
-                            # (dr_b - dr_a) . gradW_ab, summed with V_b into a, V_a into b
-                            e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
-                            s_divdr += Vb * e
-                            at[b, DIVDR] += Va * e
-                    at[a, AX] += s_ax
-                    at[a, AZ] += s_az
-                    at[a, DRHO] += s_drho
-                    if shifting:
-                        at[a, GCX] += s_gcx
-                        at[a, GCZ] += s_gcz
-                        at[a, DIVR] += s_divr
-                        at[a, WNX] += s_wnx
-                        at[a, WNZ] += s_wnz
-                    if shift_correction:
-                        at[a, DIVDR] += s_divdr
-                    if viscous_correction:
-                        at[a, VGX] += s_vgx
-                        at[a, VGZ] += s_vgz
-                        at[a, VDIVR] += s_vdivr
-                    if volume:
-                        at[a, VOLC] += s_volc
-                    if viscous_scale:
-                        at[a, NORM] += s_norm
-                    if implicit:
-                        at[a, DIAG] += s_diag
-                    if strain_correction:
-                        at[a, LAPG] += s_lapg
-                        at[a, SUPP] += s_supp
+                                ea, eb = diffusion_spec(g, ra - rb, dz, rho0, k.k_hyd)
+                                s = add(s, DRHO, ea * Vb)
+                                drho_b += eb * Va
+                    at[b, DRHO] += drho_b
+                    if packing:
+                        gx, gz, gdiv = concentration_terms(F, dx, dz, rdotg)
+                        cell_b = f.cell[b]
+                        s = add_pair(s, at, b, GCX, cell_b * gx, -(cell_a * gx))
+                        s = add_pair(s, at, b, GCZ, cell_b * gz, -(cell_a * gz))
+                        s = add_pair(s, at, b, DIVR, cell_b * gdiv, cell_a * gdiv)
+                        if kb == 1:
+                            s = add(s, WNX, -(F * f.wnx[b]))
+                            s = add(s, WNZ, -(F * f.wnz[b]))
+                        elif ka == 1:
+                            at[b, WNX] -= F * f.wnx[a]
+                            at[b, WNZ] -= F * f.wnz[a]
+                    if laminar_correction:  # gradW_ab = F r_ab; gradW_ba = -gradW_ab
+                        s = add_pair(s, at, b, VGX, Vb * F * dx, -(Va * F * dx))
+                        s = add_pair(s, at, b, VGZ, Vb * F * dz, -(Va * F * dz))
+                        s = add_pair(s, at, b, VDIVR, -(Vb * rdotg), -(Va * rdotg))
                     if velocity_gradient:
-                        at[a, DUX] += s_dux
-                        at[a, DUZ] += s_duz
-                        at[a, DWX] += s_dwx
-                        at[a, DWZ] += s_dwz
+                        # (u_b - u_a) gradW_ab for a; (u_a - u_b) gradW_ba = same sign for b
+                        s = add_pair(s, at, b, DUX, -(Vb * du * F * dx), -(Va * du * F * dx))
+                        s = add_pair(s, at, b, DUZ, -(Vb * du * F * dz), -(Va * du * F * dz))
+                        s = add_pair(s, at, b, DWX, -(Vb * dw * F * dx), -(Va * dw * F * dx))
+                        s = add_pair(s, at, b, DWZ, -(Vb * dw * F * dz), -(Va * dw * F * dz))
+                    if rheology == 2 and ka + kb == 0:
+                        lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
+                        s = add_pair(s, at, b, LAPG, Vb * lg, -(Va * lg))
+                        s = add_pair(s, at, b, SUPP, -(0.5 * Vb * rdotg), -(0.5 * Va * rdotg))
+                    if packing == 2:
+                        Wab = w_value(q, alpha)
+                        s = add_pair(s, at, b, VOLC, Vb * Wab, Va * Wab)
+                    if packing:
+                        # (dr_b - dr_a) . gradW_ab, with V_b into a, V_a into b
+                        e = F * ((f.sdx[b] - sxa) * dx + (f.sdz[b] - sza) * dz)
+                        s = add_pair(s, at, b, DIVDR, Vb * e, Va * e)
+                for q in range(NQ):
+                    at[a, q] += s[q]
         return vm, npl
-
-    switches = (diffusion, shifting, shift_correction, column_reference, viscous_correction,
-                artificial, variable_viscosity, implicit_walls, strain_correction, volume, viscous_scale)
 
     def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
         """acc[t, i, :] = the pair sums of the particles thread t writes (``PairFields`` f,
         ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
         with implicit viscosity, thread t's fluid pairs in row t of the ``PairList`` arrays.
         The threads' work is ``thread_pairs``, compiled without the parallel passes: run on
-        its long body, they took about half of the loop's compile time
-        (benchmarks/compile_time.py)."""
-        switches  # noqa: B018 -- in the closure, so that each variant has its own cache entry
+        its long body, they took about half of the loop's compile time."""
+        options  # noqa: B018 -- in the closure, so that each variant has its own cache entry
         for t in nb.prange(split.size - 1):
             # the gufunc types t as uint64 and the loop outside it as int64: one signature
             vmax[t], pair_count[t] = _thread_pairs(  # noqa: F821 -- a global given below
@@ -561,48 +519,6 @@ def make_pair_loop(diffusion: bool, shifting: bool, shift_correction: bool = Fal
     pair_loop = types.FunctionType(pair_loop.__code__, dict(globals(), _thread_pairs=thread_pairs),
                                    pair_loop.__name__, None, pair_loop.__closure__)
     return nb.njit(parallel=True, cache=True)(pair_loop)
-
-
-@nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-def continuity_of_change(x, z, du, dw, rho, vol, kind, cl, h, out):
-    """out[a] = rho_a sum_b V_b (du_ab . gradW_ab), V_b = ``vol[b]`` = m_b / rho_b, for every
-    fluid a (0 on boundary rows): the continuity rate of the velocity change (du, dw), which the
-    leapfrog density update adds to the evaluation's rate (``Simulation.step``). Each fluid
-    particle gathers over the z window (z_a - 2h, z_a + 2h) of its column and the two beside it
-    and writes its own row only (``cells.CellList`` cl, columns at least 2h wide)."""
-    start, ncx, ncz, periodic, period = cl.start, cl.ncx, cl.ncz, cl.periodic, cl.period
-    fac = grad_coefficient(h)
-    four_h2 = 4.0 * h * h
-    two_h = 2.0 * h
-    inv_h = 1.0 / h
-    for ix in nb.prange(ncx):
-        for a in range(start[ix * ncz], start[(ix + 1) * ncz]):
-            if kind[a] != 0:
-                out[a] = 0.0
-                continue
-            xa, za, dua, dwa = x[a], z[a], du[a], dw[a]
-            s = 0.0
-            for c in range(3):  # the columns ix - 1, ix, ix + 1
-                jx = ix + c - 1
-                shift = 0.0
-                if jx < 0 or jx >= ncx:
-                    if not periodic:
-                        continue
-                    shift = -period if jx < 0 else period
-                    jx = jx + ncx if jx < 0 else jx - ncx
-                b0, b1 = start[jx * ncz], start[(jx + 1) * ncz]
-                column = z[b0:b1]  # sorted by z: the window is a range
-                lo = np.searchsorted(column, za - two_h) + b0
-                hi = np.searchsorted(column, za + two_h) + b0
-                xs = xa - shift
-                for b in range(np.uint64(lo), np.uint64(hi)):
-                    # no branch, so that the loop vectorises: beyond 2h the factor is 0
-                    dx = xs - x[b]
-                    dz = za - z[b]
-                    r2 = min(dx * dx + dz * dz, four_h2)
-                    t = 1.0 - 0.5 * math.sqrt(r2) * inv_h
-                    s += vol[b] * (fac * t * t * t) * ((dua - du[b]) * dx + (dwa - dw[b]) * dz)
-            out[a] = rho[a] * s
 
 
 @nb.njit(cache=True)
@@ -687,42 +603,40 @@ VISCOUS_CORRECTION_MIN_DIVR = 1.9  # div r (m/rho volumes) of a particle with (n
 
 
 @nb.njit(parallel=True, cache=True)
-def correct_viscous_term(out, kind, nu, n, scale, normalised):
+def correct_viscous_term(out, kind, nu, n, scale, sl):
     """Remove the first-order error of the laminar term where the kernel support is full.
 
     By Taylor expansion the term sum_b 2 nu V_b F_ab u_ab approximates
     nu (M : grad grad u + 2 G . grad u), G = sum_b V_b gradW_ab, M = -sum_b V_b F r_ab r_ab:
     on a disordered arrangement G is not zero, and in a film its product with the large shear
-    makes the term too weak (13 % in the body of the paper case at dp = 1 mm with skillen,
-    benchmarks/viscous_operator.py). For fluid particles with div r >= 1.9 (away from the free
+    makes the term too weak. For fluid particles with div r >= 1.9 (away from the free
     surface, where G measures the missing neighbours rather than disorder) subtract
-    2 nu G . grad u, grad u = sum_b V_b (u_b - u_a) gradW_ab. ``normalised``: times the
-    particle's laminar factor ``scale[i]``, as the pair loop scaled the term itself. Applied
-    after the reduction: the force limit dt1 of the step uses max |a| before this correction."""
+    2 nu G . grad u times the particle's laminar factor ``scale[i]`` (as the pair loop scaled
+    the term itself), grad u = sum_b V_b (u_b - u_a) gradW_ab; ``sl``: the loop's ``Slots``.
+    Applied after the reduction: the force limit dt1 of the step uses max |a| before it."""
     for i in nb.prange(n):
-        if kind[i] != 0 or out[VDIVR, i] < VISCOUS_CORRECTION_MIN_DIVR:
+        if kind[i] != 0 or out[sl.VDIVR, i] < VISCOUS_CORRECTION_MIN_DIVR:
             continue
-        gx, gz = out[VGX, i], out[VGZ, i]
-        c = 2.0 * nu * (scale[i] if normalised else 1.0)
-        out[AX, i] -= c * (gx * out[DUX, i] + gz * out[DUZ, i])
-        out[AZ, i] -= c * (gx * out[DWX, i] + gz * out[DWZ, i])
+        gx, gz = out[sl.VGX, i], out[sl.VGZ, i]
+        c = 2.0 * nu * scale[i]
+        out[AX, i] -= c * (gx * out[sl.DUX, i] + gz * out[sl.DUZ, i])
+        out[AZ, i] -= c * (gx * out[sl.DWX, i] + gz * out[sl.DWZ, i])
 
 
 @nb.njit(parallel=True, cache=True)
-def viscous_scale_factors(out, kind, n, norm_slot, scale):
+def viscous_scale_factors(out, kind, n, sl, scale):
     """The laminar term's normalisation for the next evaluation: scale = 1 / N for fluid
-    particles with div r >= 1.9 (m/rho volumes), 1 elsewhere, N = out[norm_slot].
+    particles with div r >= 1.9 (m/rho volumes), 1 elsewhere, N = out[sl.NORM].
 
     By Taylor expansion the corrected term is nu sum_b V_b (-F) r^2 / (r^2 + eta^2)
     (r_ab . grad grad u . r_ab): for the isotropic u = |r|^2 / 4 (laplacian 1) it gives nu N,
     N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)), which a continuous kernel without eta makes 1.
     On a square lattice at Ch 1.8, N = 0.982 (0.995 from div r / 2, the rest from eta), and so
-    is the film's response nu u''. Dividing by N removes the isotropic part
-    of that error. Near the free surface (div r < 1.9) the support is cut and the term is left
-    as it is."""
+    is the film's response nu u''. Dividing by N removes the isotropic part of that error. Near
+    the free surface (div r < 1.9) the support is cut and the term is left as it is."""
     for i in nb.prange(n):
-        ok = kind[i] == 0 and out[VDIVR, i] >= VISCOUS_CORRECTION_MIN_DIVR
-        scale[i] = 1.0 / out[norm_slot, i] if ok else 1.0
+        ok = kind[i] == 0 and out[sl.VDIVR, i] >= VISCOUS_CORRECTION_MIN_DIVR
+        scale[i] = 1.0 / out[sl.NORM, i] if ok else 1.0
 
 
 @nb.njit(inline="always", cache=True)

@@ -1,4 +1,4 @@
-"""Implicit laminar viscosity (``physics.viscous_update: implicit``): backward Euler in the
+"""Implicit laminar viscosity (``numerics.viscous_update: implicit``): backward Euler in the
 viscous term, so that the viscous limit dt3 = h^2 / nu no longer bounds the step.
 
 The laminar term of the pair loop is linear in the velocities,

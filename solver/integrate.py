@@ -64,37 +64,15 @@ def kick(u, w, rho, kind, ax, az, drho, drho_prev, n, dt, rho0, clamp_boundary, 
         drho_prev[i] = drho[i]
 
 
-@nb.njit(parallel=True, cache=True)
-def leapfrog_density(rho, rho_h, drho, ddrho, drho_prev, kind, n, dt, rho0, clamp_boundary, clamp_fluid):
-    """rho^{n+1} = rho_h + dt/2 (drho + ddrho), the continuity rate at v^{n+1} (the evaluation's
-    drho at v^n plus ``forces.continuity_of_change`` of the kick), which is also the next
-    step's half-step rate; floors as in ``kick``."""
-    for i in nb.prange(n):
-        d = drho[i] + ddrho[i]
-        rho[i] = rho_h[i] + 0.5 * dt * d
-        drho_prev[i] = d
-        if kind[i] == 0:
-            if clamp_fluid and rho[i] < rho0:
-                rho[i] = rho0
-        elif clamp_boundary and rho[i] < rho0:
-            rho[i] = rho0
-
-
-def viscous_cfl(cfl, cfl_viscous=None):
-    """C_nu of the viscous limit: ``cfl_viscous``, or C when it is None (SPEC eq. 7's one C)."""
-    return cfl if cfl_viscous is None else cfl_viscous
-
-
-def time_step(cfl, h, amax, vmax, c0, nu, cfl_viscous=None, viscous_limit=True, cfl_acoustic=None):
-    """(dt, index of the limiting term, (dt1, dt2, dt3)) of SPEC eq. 7:
-    dt = min(C dt1, C_a dt2, C_nu dt3), C = ``cfl``, C_a = ``cfl_acoustic`` (default C),
-    C_nu = ``cfl_viscous`` (default C; with both defaults this is C min(dt1, dt2, dt3) as SPEC
-    writes it). Without ``viscous_limit`` (an implicit laminar term) dt = min(C dt1, C_a dt2);
-    dt3 is still reported."""
+def time_step(cfl, h, amax, vmax, c0, nu, viscous_limit=True, cfl_acoustic=None):
+    """(dt, index of the limiting term, (dt1, dt2, dt3)) of docs/scheme.md section 6:
+    dt = min(C dt1, C_a dt2, C dt3), C = ``cfl``, C_a = ``cfl_acoustic`` (default C, which gives
+    C min(dt1, dt2, dt3) as the paper writes it). Without ``viscous_limit`` (an implicit or
+    sub-stepped laminar term) dt = min(C dt1, C_a dt2); dt3 is still reported."""
     dt1 = math.sqrt(h / amax) if amax > 0 else math.inf
     dt2 = h / (c0 + vmax)
     dt3 = h * h / nu
-    c_nu = viscous_cfl(cfl, cfl_viscous) if viscous_limit else math.inf
+    c_nu = cfl if viscous_limit else math.inf
     c_a = cfl if cfl_acoustic is None else cfl_acoustic
     scaled = (cfl * dt1, c_a * dt2, c_nu * dt3)
     k = int(np.argmin(scaled))

@@ -70,7 +70,7 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         "threads": res.threads,
         "n_particles": res.n_particles,
         "dp": sc.dp, "h": sc.h, "c0": sc.c0, "rho0": sc.fluid.density,
-        "viscous_update": sc.viscous_update_used,
+        "viscous_update": sc.numerics.viscous_update,
         "cfl_acoustic": sc.cfl_acoustic,
         "cg_iterations": res.cg_iterations,
         "rkc_stages": res.rkc_stages,

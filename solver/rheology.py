@@ -15,13 +15,11 @@ import math
 
 import numba as nb
 
-from .forces import DUX, DUZ, DWX, DWZ, LAPG, SUPP
-
 
 @nb.njit(inline="always", cache=True)
-def strain_rate(out, i):
-    """gamma of particle i from the gradient sums in ``out`` (module docstring)."""
-    ux, uz, wx, wz = out[DUX, i], out[DUZ, i], out[DWX, i], out[DWZ, i]
+def strain_rate(out, i, sl):
+    """gamma of particle i from the gradient sums in ``out`` (slots ``sl``, module docstring)."""
+    ux, uz, wx, wz = out[sl.DUX, i], out[sl.DUZ, i], out[sl.DWX, i], out[sl.DWZ, i]
     s = uz + wx
     return math.sqrt(2.0 * ux * ux + 2.0 * wz * wz + s * s)
 
@@ -47,9 +45,9 @@ FULL_SUPPORT = 0.95  # support sum_b V_b (-F r^2) / 2 (1 inside the fluid) above
 
 
 @nb.njit(parallel=True, cache=True)
-def update_viscosity(out, kind, nu_p, n_active, rho0, tau_y, K, n, mu_max, m, gamma_p, kh2):
+def update_viscosity(out, kind, nu_p, n_active, rho0, tau_y, K, n, mu_max, m, gamma_p, kh2, sl):
     """nu_p[i] = mu(gamma_i) / rho0 for fluid particles from the gradient sums in ``out``;
-    returns the largest nu_p (for the viscous time-step limit).
+    returns the largest nu_p (for the viscous time-step limit); ``sl``: the pair loop's ``Slots``.
 
     With ``kh2`` = kappa h^2 > 0 (``fluid.strain_rate_correction``) the kernel smoothing's
     second-order error is removed where the support is full (SUPP >= FULL_SUPPORT):
@@ -60,11 +58,11 @@ def update_viscosity(out, kind, nu_p, n_active, rho0, tau_y, K, n, mu_max, m, ga
     for i in nb.prange(n_active):
         if kind[i] != 0:
             continue
-        g = strain_rate(out, i)
+        g = strain_rate(out, i, sl)
         if kh2 > 0.0:
             gamma_p[i] = g
-            if out[SUPP, i] >= FULL_SUPPORT:
-                g = max(0.0, g - kh2 * out[LAPG, i])
+            if out[sl.SUPP, i] >= FULL_SUPPORT:
+                g = max(0.0, g - kh2 * out[sl.LAPG, i])
         nu_p[i] = effective_viscosity(g, tau_y, K, n, mu_max, m) / rho0
         numax = max(numax, nu_p[i])
     return numax

@@ -19,14 +19,10 @@ NEAR_SURFACE = ("none", "tangential")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
-VISCOUS_UPDATES = ("explicit", "implicit", "substepped", "auto", "auto_substepped")
-DENSITY_UPDATES = ("explicit", "leapfrog")
+VISCOUS_UPDATES = ("explicit", "implicit", "substepped")
 CFL_RULES = ("fixed", "damping")
 MIN_DAMPED_CFL = 0.05  # the damping rule refuses a scene it would take below this acoustic C
-# auto: implicit where the explicit viscous step is at least this many times below the acoustic
-# one (an implicit step costs 2.7-3.5 explicit ones on the paper case at dp = 0.25 mm:
-# docs/numerics.md, "Implicit viscosity")
-AUTO_IMPLICIT_RATIO = 3.0
+CH_RANGE = (1.0, 4.0)  # h / dp: below 1 a particle's support holds too few neighbours to be stable
 LIND_MIN_CH = 1.1  # below it Lind shifting fails on the conveyor case (docs/numerics.md)
 BYTES_PER_PARTICLE = 400  # state, sort buffers and per-thread accumulators (2 threads)
 
@@ -143,56 +139,52 @@ class Sound:
 
 
 # Lind moves particles by up to 0.1 dp every step; a density correction that followed each
-# such move in full would erase the compression the pressure needs (see docs/numerics.md)
+# such move in full would erase the compression the pressure needs (docs/numerics.md)
 LIND_CORRECTION_LIMIT = 1.0e-3
+SURFACE_THRESHOLD = 1.5  # div r below this marks the free surface (docs/scheme.md section 6)
+MAX_SHIFT = 0.1  # clip of each shift component per step, in units of dp
 
 
 @dataclass
 class Shifting:
+    """Particle shifting (docs/scheme.md section 6). The density follows each shift's volume
+    change, rho *= 1 - div(dr) (Lind's limited to LIND_CORRECTION_LIMIT per step)."""
+
     method: str = "none"
     coefficient: float | None = None  # A (skillen, default 2) or A_L (lind, default 1)
-    surface_threshold: float = 1.5  # div r below this marks the free surface
-    max_shift: float = 0.1  # clip of each shift component per step, in units of dp
-    # rho *= 1 - div(dr): shifting keeps volume and density consistent (null: on)
-    density_correction: bool | None = None
-    # limit of |div(dr)| per step in that correction; null: the method's default (lind 1e-3,
-    # skillen none), 0 or a negative value is rejected
-    correction_limit: float | None = None
-    # skillen: the speed in dr = -A h |u| dt gradC is max(|u|, min_speed) [m/s] (0: SPEC's |u|)
+    # skillen: the speed in dr = -A h |u| dt gradC is max(|u|, min_speed) [m/s] (0: |u|)
     min_speed: float = 0.0
-    # lind within 2h of the free surface: "none" (SPEC: no shift) or "tangential" (the part of
-    # the shift along the surface, Lind et al. 2012; docs/numerics.md)
+    # lind within 2h of the free surface: "none" (no shift) or "tangential" (the part of the
+    # shift along the surface)
     near_surface: str = "none"
 
 
 @dataclass
-class Physics:
+class Numerics:
+    """Every numerics choice of a run; the defaults are the paper's scheme (docs/scheme.md
+    section 6), the departures are described in docs/numerics.md."""
+
+    cfl: float = 0.2  # C of dt = C min(dt1, dt2, dt3)
+    # fixed: the acoustic limit's C is cfl; damping: at most 0.85 times the edge C* at which the
+    # laminar term and the density diffusion still damp the acoustic pair (solver/acoustic_edge.py)
+    cfl_rule: str = "fixed"
     boundary: str = "mdbc"
-    mdbc_velocity: str = "shepard"  # ghost velocity: shepard (SPEC) or corrected (first order)
+    mdbc_velocity: str = "shepard"  # ghost velocity: shepard (the paper's) or corrected (first order)
     # floor each wall density by the particle number density around it (fluid pressed into a wall)
     no_penetration: bool = False
     density_diffusion: float | None = 0.1  # delta; null/false switches it off
-    # rho^H_ab of the diffusion: spec (SPEC's printed form) or column (the Tait column at rest)
+    # rho^H_ab of the diffusion: spec (the paper's form) or column (the Tait column at rest)
     density_diffusion_reference: str = "spec"
-    # remove the laminar term's first-order error 2 nu G . grad u where the support is full
+    # the consistent laminar term: its first-order error 2 nu G . grad u removed and the term
+    # divided by its lattice normaliser N where the support is full (forces.correct_viscous_term)
     viscous_correction: bool = False
-    # divide the (corrected) laminar term by its lattice normaliser N where the support is full,
-    # a pair by the mean of its particles' factors from the last evaluation (needs
-    # viscous_correction; forces.viscous_scale_factors)
-    viscous_normalisation: bool = False
     # beta: interior density relaxes towards the particles' packing at a rate beta c0 / h
     # (solver/packing.py); null: off
     volume_relaxation: float | None = None
-    # explicit (SPEC: the laminar term at v^n, dt bounded by h^2 / nu), implicit (backward
-    # Euler in the laminar term, no viscous limit on dt: solver/implicit.py), substepped (the
-    # same operator integrated over the step by explicit Runge-Kutta-Chebyshev stages, no viscous
-    # limit on dt), auto (implicit where it saves steps: Scene.implicit_viscosity) or
-    # auto_substepped (substepped there)
+    # explicit (the laminar term at v^n, dt bounded by h^2 / nu), implicit (backward Euler in the
+    # laminar term) or substepped (the same operator over the step by Runge-Kutta-Chebyshev
+    # stages); the last two lift the viscous limit on dt (solver/implicit.py)
     viscous_update: str = "explicit"
-    # explicit: rho^{n+1} = rho^n + dt drho/dt at v^n (the step's one evaluation); leapfrog: the
-    # density's second half step takes the continuity rate at v^{n+1} (a continuity-only pass
-    # over the pairs after the kick; docs/numerics.md, "The leapfrog density update")
-    density_update: str = "explicit"
     # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
     artificial_viscosity: float | None = None
     # floor the fluid density at rho0 after each step: no negative pressure, no tensile clumping
@@ -239,15 +231,9 @@ class Scene(YamlData):
     ch: float = 1.5
     walls: list[Wall] = field(default_factory=list)
     gravity: tuple[float, float] = (0.0, -9.81)
-    cfl: float = 0.2
-    cfl_viscous: float | None = None  # C of the viscous limit dt3 alone; null: cfl (SPEC eq. 7)
-    # fixed: the acoustic limit's C is cfl (SPEC eq. 7); damping: at most 0.85 times the edge C* at
-    # which the laminar term and the density diffusion still damp the acoustic pair
-    # (solver/acoustic_edge.py; Scene.cfl_acoustic)
-    cfl_rule: str = "fixed"
     periodic_x: tuple[float, float] | None = None
     domain: Domain | None = None
-    physics: Physics = field(default_factory=Physics)
+    numerics: Numerics = field(default_factory=Numerics)
     guards: Guards = field(default_factory=Guards)
     memory_budget_gb: float = 4.0
 
@@ -278,58 +264,34 @@ class Scene(YamlData):
 
     @property
     def cfl_acoustic(self) -> float:
-        """C of the acoustic limit dt2: ``cfl``, or with ``cfl_rule: damping`` and the explicit
-        density update min(cfl, 0.85 C*(Ch, nu / (c0 h), delta)) (``acoustic_edge.damped_cfl``).
-        The leapfrog update keeps ``cfl``: its acoustic pair is neutral (docs/numerics.md)."""
-        if self.cfl_rule == "fixed" or self.physics.density_update == "leapfrog":
-            return self.cfl
+        """C of the acoustic limit dt2: ``numerics.cfl``, or with ``cfl_rule: damping``
+        min(cfl, 0.85 C*(Ch, nu / (c0 h), delta)) (``acoustic_edge.damped_cfl``)."""
+        n = self.numerics
+        if n.cfl_rule == "fixed":
+            return n.cfl
         from .acoustic_edge import damped_cfl
-        return damped_cfl(self.cfl, self.ch, self.acoustic_damping_ratio, self.physics.density_diffusion)
+        return damped_cfl(n.cfl, self.ch, self.acoustic_damping_ratio, n.density_diffusion)
 
     @property
     def implicit_viscosity(self) -> bool:
         """Whether the laminar term leaves the explicit step (its operator listed by the pair
-        loop, no viscous limit on dt): ``viscous_update: implicit`` or ``substepped``, or
-        ``auto`` and ``auto_substepped`` where the explicit viscous step C_nu h^2 / nu is at
-        least AUTO_IMPLICIT_RATIO times below the acoustic one C h / c0 (C_nu = cfl_viscous,
-        or cfl)."""
-        update = self.physics.viscous_update
-        if not update.startswith("auto"):
-            return update in ("implicit", "substepped")
-        from .integrate import time_step, viscous_cfl  # SPEC eq. 7's limits, at rest
-        _, _, (_, dt_acoustic, dt_viscous) = time_step(self.cfl, self.h, 0.0, 0.0, self.c0, self.nu)
-        c_nu = viscous_cfl(self.cfl, self.cfl_viscous)
-        return self.cfl * dt_acoustic >= AUTO_IMPLICIT_RATIO * c_nu * dt_viscous
+        loop, no viscous limit on dt): ``viscous_update`` implicit or substepped."""
+        return self.numerics.viscous_update != "explicit"
 
     @property
     def viscous_substeps(self) -> bool:
         """Whether the laminar term's operator is integrated by Runge-Kutta-Chebyshev stages
         (``solver.implicit.substep``) rather than solved by backward Euler."""
-        return self.implicit_viscosity and self.physics.viscous_update in ("substepped", "auto_substepped")
-
-    @property
-    def viscous_update_used(self) -> str:
-        """explicit, implicit or substepped: what ``viscous_update`` amounts to for this scene."""
-        if not self.implicit_viscosity:
-            return "explicit"
-        return "substepped" if self.viscous_substeps else "implicit"
-
-    @property
-    def shift_density_correction(self) -> bool:
-        s = self.physics.shifting
-        return s.density_correction if s.density_correction is not None else s.method != "none"
+        return self.numerics.viscous_update == "substepped"
 
     @property
     def shift_correction_limit(self) -> float:
-        """Per-step limit of |div(dr)| in the density correction (inf: none)."""
-        s = self.physics.shifting
-        if s.correction_limit is not None:
-            return s.correction_limit
-        return LIND_CORRECTION_LIMIT if s.method == "lind" else math.inf
+        """Per-step limit of |div(dr)| in the shift's density correction (inf: none)."""
+        return LIND_CORRECTION_LIMIT if self.numerics.shifting.method == "lind" else math.inf
 
     @property
     def shifting_coefficient(self) -> float:
-        s = self.physics.shifting
+        s = self.numerics.shifting
         if s.coefficient is not None:
             return s.coefficient
         return 2.0 if s.method == "skillen" else 1.0
@@ -357,8 +319,26 @@ def load_scene(path) -> Scene:
     return scene_from_dict(read_yaml(path))
 
 
+def refuse_moved_keys(data: Any, moved: dict[str, str], where: str) -> None:
+    """SceneError for a key of an older layout, saying where it lives now."""
+    if isinstance(data, dict):
+        for key, now in moved.items():
+            if key in data:
+                raise SceneError(f"{where}{key}: {now}")
+
+
+# keys of the scene's top level that moved into ``numerics`` (or were removed)
+MOVED_SCENE_KEYS = {
+    "physics": "renamed numerics (which also holds cfl and cfl_rule)",
+    "cfl": "now numerics.cfl",
+    "cfl_rule": "now numerics.cfl_rule",
+    "cfl_viscous": "removed: one C for the force and viscous limits (numerics.cfl)",
+}
+
+
 def scene_from_dict(data: Any) -> Scene:
     """Build a Scene from plain data, check types and values; raise SceneError."""
+    refuse_moved_keys(data, MOVED_SCENE_KEYS, "")
     scene = parse_into(Scene, data, "scene")
     validate(scene)
     return scene
@@ -478,36 +458,78 @@ def _validate_rheology(scene: Scene) -> None:
         raise SceneError(f"fluid.yield_stress: must be >= 0, got {f.yield_stress}")
     if f.papanastasiou is not None:
         _positive(f.papanastasiou, "fluid.papanastasiou")
-    if scene.physics.viscous_correction:
-        raise SceneError("physics.viscous_correction: only for rheology newtonian")
+    if scene.numerics.viscous_correction:
+        raise SceneError("numerics.viscous_correction: only for rheology newtonian")
+
+
+def _one_of(value, allowed, key):
+    if value not in allowed:
+        raise SceneError(f"{key}: {value!r} is not one of {', '.join(allowed)}")
 
 
 def _validate_cfl_rule(scene: Scene) -> None:
-    if scene.cfl_rule not in CFL_RULES:
-        raise SceneError(f"cfl_rule: {scene.cfl_rule!r} is not one of {', '.join(CFL_RULES)}")
-    if scene.cfl_rule == "fixed":
+    n = scene.numerics
+    _one_of(n.cfl_rule, CFL_RULES, "numerics.cfl_rule")
+    if n.cfl_rule == "fixed":
         return
     if not scene.fluid.newtonian:
-        raise SceneError("cfl_rule: damping needs one viscosity (rheology newtonian); a "
-                         f"{scene.fluid.rheology} fluid's laminar damping varies with its strain rate")
+        raise SceneError("numerics.cfl_rule: damping needs one viscosity (rheology newtonian); a "
+                         f"{scene.fluid.rheology} fluid's laminar damping varies with its strain rate. "
+                         "Set numerics.cfl_rule: fixed with a numerics.cfl you have checked (0.4 with "
+                         "viscous_update: implicit holds the shipped yield-stress campaign)")
     c = scene.cfl_acoustic
-    if c < scene.cfl and c < MIN_DAMPED_CFL:  # the rule, not the user's cfl, takes C this low
+    if c < n.cfl and c < MIN_DAMPED_CFL:  # the rule, not the user's cfl, takes C this low
         raise SceneError(
-            f"cfl_rule: damping gives an acoustic C of {c:.3g} (nu / (c0 h) = "
-            f"{scene.acoustic_damping_ratio:.3g}, density_diffusion = {scene.physics.density_diffusion}): "
+            f"numerics.cfl_rule: damping gives an acoustic C of {c:.3g} (nu / (c0 h) = "
+            f"{scene.acoustic_damping_ratio:.3g}, density_diffusion = {n.density_diffusion}): "
             "the laminar term and the density diffusion barely damp the acoustic modes. Use "
-            "physics.density_update: leapfrog, or cfl_rule: fixed with a C you have checked")
+            "cfl_rule: fixed with a C you have checked")
+
+
+def _validate_shifting(scene: Scene) -> None:
+    sh = scene.numerics.shifting
+    _one_of(sh.method, SHIFTING_METHODS, "numerics.shifting.method")
+    if sh.method == "lind" and scene.ch < LIND_MIN_CH:
+        raise SceneError(
+            f"numerics.shifting.method: lind needs ch >= {LIND_MIN_CH:g}, got ch = {scene.ch:g}: with "
+            "h = dp a particle has only 8 neighbours within 2h, and Lind's shift inflates or "
+            "diverges the fluid at rest. Use ch >= 1.1, or shifting skillen or none (docs/numerics.md)")
+    if sh.coefficient is not None:
+        _positive(sh.coefficient, "numerics.shifting.coefficient")
+    if not (sh.min_speed >= 0 and math.isfinite(sh.min_speed)):
+        raise SceneError(f"numerics.shifting.min_speed: must be a finite number >= 0 [m/s], got {sh.min_speed!r}")
+    _one_of(sh.near_surface, NEAR_SURFACE, "numerics.shifting.near_surface")
+
+
+def _validate_numerics(scene: Scene) -> None:
+    """The numerics block: each key's allowed values (min_speed is skillen's and near_surface
+    lind's; each method ignores the other's key, so that one scheme serves both)."""
+    n = scene.numerics
+    _positive(n.cfl, "numerics.cfl")
+    _one_of(n.boundary, BOUNDARY_METHODS, "numerics.boundary")
+    _one_of(n.mdbc_velocity, MDBC_VELOCITY, "numerics.mdbc_velocity")
+    _one_of(n.viscous_update, VISCOUS_UPDATES, "numerics.viscous_update")
+    _one_of(n.density_diffusion_reference, DIFFUSION_REFERENCES, "numerics.density_diffusion_reference")
+    if n.density_diffusion is not None and not n.density_diffusion >= 0:
+        raise SceneError(f"numerics.density_diffusion: must be >= 0, got {n.density_diffusion}")
+    _validate_cfl_rule(scene)
+    if n.artificial_viscosity is not None and not 0 <= n.artificial_viscosity <= 1:
+        raise SceneError("numerics.artificial_viscosity: must lie in [0, 1] (DualSPHysics' default "
+                         f"is 0.01) or be null, got {n.artificial_viscosity}")
+    _validate_shifting(scene)
+    if n.volume_relaxation is not None and not n.volume_relaxation > 0:
+        raise SceneError("numerics.volume_relaxation: a rate beta > 0 (0.1 in the surge scheme) "
+                         f"or null, got {n.volume_relaxation!r}")
 
 
 def validate(scene: Scene) -> None:
     """Check physical and geometric consistency; raise SceneError naming the key."""
     _positive(scene.dp, "dp")
     _positive(scene.ch, "ch")
-    if not 0.5 <= scene.ch <= 4.0:
-        raise SceneError(f"ch: h/dp must lie in [0.5, 4], got {scene.ch}")
-    _positive(scene.cfl, "cfl")
-    if scene.cfl_viscous is not None:
-        _positive(scene.cfl_viscous, "cfl_viscous")
+    lo, hi = CH_RANGE
+    if not lo <= scene.ch <= hi:
+        raise SceneError(f"ch: h/dp must lie in [{lo:g}, {hi:g}], got {scene.ch:g}: below 1 the kernel "
+                         "support 2h holds too few neighbours for a stable sum")
     _positive(scene.fluid.density, "fluid.density")
     _validate_rheology(scene)
     if not scene.fluid.blocks and not scene.fluid.profiles:
@@ -528,70 +550,7 @@ def validate(scene: Scene) -> None:
     _positive(scene.time.output_interval, "time.output_interval")
     if scene.time.diagnostics_interval is not None:
         _positive(scene.time.diagnostics_interval, "time.diagnostics_interval")
-    ph = scene.physics
-    if ph.boundary not in BOUNDARY_METHODS:
-        raise SceneError(
-            f"physics.boundary: {ph.boundary!r} is not one of {', '.join(BOUNDARY_METHODS)}")
-    if ph.mdbc_velocity not in MDBC_VELOCITY:
-        raise SceneError(
-            f"physics.mdbc_velocity: {ph.mdbc_velocity!r} is not one of {', '.join(MDBC_VELOCITY)}")
-    if ph.viscous_update not in VISCOUS_UPDATES:
-        raise SceneError(
-            f"physics.viscous_update: {ph.viscous_update!r} is not one of {', '.join(VISCOUS_UPDATES)}")
-    if ph.density_update not in DENSITY_UPDATES:
-        raise SceneError(
-            f"physics.density_update: {ph.density_update!r} is not one of {', '.join(DENSITY_UPDATES)}")
-    if ph.viscous_normalisation and not ph.viscous_correction:
-        raise SceneError("physics.viscous_normalisation: needs physics.viscous_correction: true (it "
-                         "normalises the corrected laminar term, where the correction's div r finds "
-                         "full support)")
-    if ph.density_diffusion is not None and not ph.density_diffusion >= 0:
-        raise SceneError(f"physics.density_diffusion: must be >= 0, got {ph.density_diffusion}")
-    _validate_cfl_rule(scene)
-    if ph.artificial_viscosity is not None and not 0 <= ph.artificial_viscosity <= 1:
-        raise SceneError("physics.artificial_viscosity: must lie in [0, 1] (DualSPHysics' default "
-                         f"is 0.01) or be null, got {ph.artificial_viscosity}")
-    if ph.density_diffusion_reference not in DIFFUSION_REFERENCES:
-        raise SceneError(f"physics.density_diffusion_reference: {ph.density_diffusion_reference!r} "
-                         f"is not one of {', '.join(DIFFUSION_REFERENCES)}")
-    sh = ph.shifting
-    if ph.volume_relaxation is not None:
-        if not ph.volume_relaxation > 0:
-            raise SceneError("physics.volume_relaxation: a rate beta > 0 (0.1 measured, "
-                             f"docs/numerics.md) or null, got {ph.volume_relaxation!r}")
-        if sh.method == "none":
-            raise SceneError("physics.volume_relaxation: needs shifting (skillen or lind): it "
-                             "finds the interior by the shifting's concentration gradient")
-    if sh.method not in SHIFTING_METHODS:
-        raise SceneError(
-            f"physics.shifting.method: {sh.method!r} is not one of {', '.join(SHIFTING_METHODS)}")
-    if sh.method == "lind" and scene.ch < LIND_MIN_CH:
-        raise SceneError(
-            f"physics.shifting.method: lind needs ch >= {LIND_MIN_CH:g}, got ch = {scene.ch:g}. With "
-            "h = dp a particle has only 8 neighbours within 2h. Measured on the conveyor case at "
-            "dp = 2 mm: with the density correction at its default limit the fluid diverges at rest "
-            "within 400 steps (density +10 %); with the correction limited to 1e-4 or off it inflates "
-            "5.5 % in 0.3 s; ch = 1.1 and 1.2 keep the area within 0.4 % over 1.5 s. Use ch >= 1.1, "
-            "or shifting skillen or none (docs/numerics.md)")
-    if sh.coefficient is not None:
-        _positive(sh.coefficient, "physics.shifting.coefficient")
-    _positive(sh.max_shift, "physics.shifting.max_shift")
-    if sh.correction_limit is not None:
-        _positive(sh.correction_limit, "physics.shifting.correction_limit")
-    if not (sh.min_speed >= 0 and math.isfinite(sh.min_speed)):
-        raise SceneError(f"physics.shifting.min_speed: must be a finite number >= 0 [m/s], got {sh.min_speed!r}")
-    if sh.min_speed > 0 and sh.method != "skillen":
-        raise SceneError(f"physics.shifting.min_speed: applies to method skillen only (its shift scales "
-                         f"with |u|), got method {sh.method!r}")
-    if sh.near_surface not in NEAR_SURFACE:
-        raise SceneError(f"physics.shifting.near_surface: {sh.near_surface!r} is not one of "
-                         f"{', '.join(NEAR_SURFACE)}")
-    if sh.near_surface != "none" and sh.method != "lind":
-        raise SceneError(f"physics.shifting.near_surface: applies to method lind only (skillen scales its "
-                         f"shift near the surface by div r), got method {sh.method!r}")
-    if not 0 < sh.surface_threshold < 2:
-        raise SceneError(
-            f"physics.shifting.surface_threshold: must lie in (0, 2), got {sh.surface_threshold}")
+    _validate_numerics(scene)
     g = scene.guards
     _positive(g.max_density_deviation, "guards.max_density_deviation")
     _positive(g.min_dt_fraction, "guards.min_dt_fraction")

@@ -1,14 +1,14 @@
 """Particle shifting from the concentration gradient gradC and the free-surface measure div r.
 
 skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - thr)/(2 - thr)
-         up to div r = 2, each component clipped to max_shift dp. With ``min_speed`` > 0 the
+         up to div r = 2, each component clipped to MAX_SHIFT dp. With ``min_speed`` > 0 the
          speed is max(|u_a|, min_speed) where no wall particle is within 2h: |u_a| depends on
          the frame, and where the lab-frame velocity passes through zero inside a sheared layer
          SPEC's shift vanishes while the shear keeps disordering the particles. Within reach of
          a wall SPEC's |u_a| stays: slow fluid there is a stagnant corner (a free surface
          against a wall), which a floored shift pulls apart (docs/numerics.md, "Skillen's speed
          floor").
-lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to max_shift dp; no shift for
+lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to MAX_SHIFT dp; no shift for
          particles within 2h of a free-surface particle (div r < thr, or a scan-region test
          where thr <= div r < 1.9, see free_surface). With ``near_surface: tangential``
          (Lind et al. 2012) those particles shift too, by the part of gradC along the surface

@@ -9,7 +9,7 @@ import numpy as np
 from . import boundary, cells, forces, guards, implicit, integrate, packing, rheology, shifting
 from .build import Particles, build_particles
 from .kernel import alpha_2d
-from .scene import Scene
+from .scene import MAX_SHIFT, SURFACE_THRESHOLD, Scene
 
 _SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "pid")
 _SHIFTING = ("cell_volume", "wnx", "wnz")  # read by the shifting sums alone
@@ -68,53 +68,43 @@ class Simulation:
         s = scene
         self.h, self.rho0, self.c0, self.nu = s.h, s.fluid.density, s.c0, s.nu
         self.B = self.c0 ** 2 * self.rho0 / 7.0
-        self.delta = s.physics.density_diffusion or 0.0
+        num = s.numerics
+        self.delta = num.density_diffusion or 0.0
         self.diffusion = self.delta > 0
-        self.shift_method = s.physics.shifting.method
+        self.shift_method = num.shifting.method
         shifting_on = self.shift_method != "none"
-        self.correct_shift = shifting_on and s.shift_density_correction
-        self.viscous_correction = bool(s.physics.viscous_correction)
-        self.viscous_normalisation = bool(s.physics.viscous_normalisation)
-        # each particle's laminar factor, from the last evaluation (viscous_normalisation)
-        self.viscous_scale = np.ones(self.n if self.viscous_normalisation else 1)
+        self.viscous_correction = bool(num.viscous_correction)
+        # each particle's laminar factor, from the last evaluation (viscous_correction)
+        self.viscous_scale = np.ones(self.n if self.viscous_correction else 1)
         self.variable_viscosity = not s.fluid.newtonian
         self.strain_correction = self.variable_viscosity and bool(s.fluid.strain_rate_correction)
         # the last strain rate (strain_rate_correction; a placeholder otherwise)
         self.gamma_p = np.zeros(self.n if self.strain_correction else 1)
         self.implicit = s.implicit_viscosity
-        self.volume_relaxation = s.physics.volume_relaxation or 0.0
-        # its concentration's slot (the option needs shifting)
-        self.volume_slot = forces.volume_slot(True, self.correct_shift, self.viscous_correction,
-                                              self.variable_viscosity, self.strain_correction)
-        self.mdbc = s.physics.boundary == "mdbc"
-        self.leapfrog = s.physics.density_update == "leapfrog"  # the density at v^{n+1}: step()
+        self.volume_relaxation = num.volume_relaxation or 0.0
+        self.mdbc = num.boundary == "mdbc"
         self.cfl_acoustic = s.cfl_acoustic  # C of the acoustic limit (cfl_rule)
-        self.nq = forces.n_slots(shifting_on, self.correct_shift, self.viscous_correction,
-                                 self.variable_viscosity, self.implicit, self.strain_correction,
-                                 self.volume_relaxation > 0, self.viscous_normalisation)
-        self.norm_slot = forces.norm_slot(shifting_on, self.correct_shift, self.viscous_correction,
-                                          self.variable_viscosity, self.strain_correction,
-                                          self.volume_relaxation > 0)
-        # the pair loop's compile-time switches (``forces.make_pair_loop``)
-        self.pair_options = dict(
-            diffusion=self.diffusion, shifting=shifting_on, shift_correction=self.correct_shift,
-            column_reference=s.physics.density_diffusion_reference == "column",
-            viscous_correction=self.viscous_correction, artificial=bool(s.physics.artificial_viscosity),
-            variable_viscosity=self.variable_viscosity,
-            implicit_walls=(2.0 if self.mdbc else 1.0) if self.implicit else 0.0,
-            strain_correction=self.strain_correction, volume=self.volume_relaxation > 0,
-            viscous_scale=self.viscous_normalisation)
-        self.pair_loop = forces.make_pair_loop(**self.pair_options)
+        # the pair loop's compile-time switches (``forces.PairOptions``) and its slots
+        self.pair_options = forces.PairOptions(
+            diffusion=(2 if num.density_diffusion_reference == "column" else 1) if self.diffusion else 0,
+            packing=2 if self.volume_relaxation > 0 else (1 if shifting_on else 0),
+            laminar_correction=self.viscous_correction,
+            rheology=(2 if self.strain_correction else 1) if self.variable_viscosity else 0,
+            artificial=bool(num.artificial_viscosity),
+            implicit_walls=(2.0 if self.mdbc else 1.0) if self.implicit else 0.0)
+        self.slots = forces.slot_layout(self.pair_options)
+        self.nq = self.slots.nq
+        self.pair_loop = forces.make_pair_loop(self.pair_options)
         self.substeps = s.viscous_substeps  # RKC stages rather than CG (no CG start to carry)
-        self.sorted_fields = (_SORTED + (_SHIFTING if shifting_on else ()) + (_SHIFT if self.correct_shift else ())
+        self.sorted_fields = (_SORTED + (_SHIFTING + _SHIFT if self.pair_options.packing else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
-                              + (("viscous_scale",) if self.viscous_normalisation else ())
+                              + (("viscous_scale",) if self.viscous_correction else ())
                               + (_IMPLICIT if self.implicit and not self.substeps else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
         self.rkc_stages = 0  # stages of the sub-stepped viscous updates, summed
-        self.mdbc_update = boundary.make_mdbc_update(s.physics.mdbc_velocity == "corrected",
-                                                     bool(s.physics.no_penetration))
+        self.mdbc_update = boundary.make_mdbc_update(num.mdbc_velocity == "corrected",
+                                                     bool(num.no_penetration))
         self.n_lattice = boundary.lattice_number_density(s.ch)
 
         x0, x1, z0, z1 = default_domain(s)
@@ -148,14 +138,14 @@ class Simulation:
         self.constants = forces.PairConstants(
             h=self.h, nu=self.nu, hc0=self.h * self.c0, rho0=self.rho0,
             k_hyd=self.rho0 * s.gravity[1] / self.B, k_col=self.rho0 * s.gravity[1] / self.c0 ** 2,
-            delta=self.delta, av=(s.physics.artificial_viscosity or 0.0) * self.h * self.c0)
+            delta=self.delta, av=(num.artificial_viscosity or 0.0) * self.h * self.c0)
         self.p = np.zeros(self.n)
         self.irho = np.zeros(self.n)  # 1 / rho, for the pair loop
         self.shift_dx = np.zeros(self.n)
         self.shift_dz = np.zeros(self.n)
         self.surface_flag = np.zeros(self.n, dtype=np.int8)
         self.near_flag = np.zeros(self.n, dtype=np.int8)
-        tangential = s.physics.shifting.near_surface == "tangential"
+        tangential = shifting_on and num.shifting.near_surface == "tangential"
         self.surface_nx = np.zeros(self.n if tangential else 1)  # lind's surface normals
         self.surface_nz = np.zeros(self.n if tangential else 1)
         self.wall_s0 = shifting.wall_proximity_at_half_dp(self.h, s.dp)
@@ -219,17 +209,16 @@ class Simulation:
         self.vmax = float(self.vmax_t.max())
         if self.viscous_correction:
             forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active, self.viscous_scale,
-                                        self.viscous_normalisation)
-            if self.viscous_normalisation:  # the factors of the next evaluation
-                forces.viscous_scale_factors(self.out, self.kind, self.n_active, self.norm_slot,
-                                             self.viscous_scale)
+                                        self.slots)
+            # the factors of the next evaluation
+            forces.viscous_scale_factors(self.out, self.kind, self.n_active, self.slots, self.viscous_scale)
         if self.variable_viscosity:  # the viscosity of the next evaluation
             fl = s.fluid
             self.nu_max_now = rheology.update_viscosity(
                 self.out, self.kind, self.nu_p, self.n_active, self.rho0, fl.yield_stress,
                 fl.consistency, fl.index, fl.max_viscosity, fl.papanastasiou or 0.0, self.gamma_p,
-                rheology.SMOOTHING_KAPPA * self.h ** 2 if self.strain_correction else 0.0)
-        if self.correct_shift:
+                rheology.SMOOTHING_KAPPA * self.h ** 2 if self.strain_correction else 0.0, self.slots)
+        if self.shift_method != "none":
             self._correct_density()
         return ""
 
@@ -243,24 +232,9 @@ class Simulation:
             boundary.dbc_velocity(self.kind, self.wall, self.wall_velocities(t), self.u, self.w,
                                   self.n_active)
 
-    def _leapfrog_density(self, t: float, dt: float, u0, w0, rho_h):
-        """After the kick (velocities v^{n+1}, positions still those of the evaluation at t):
-        rho^{n+1} = rho_h + dt/2 drho/dt at v^{n+1}, the evaluation's rate at v^n plus the
-        continuity rate of the velocity change, the walls' included (set again from the
-        kicked fluid)."""
-        n = self.n_active
-        self._set_walls(t)
-        du, dw = self.u - u0, self.w - w0
-        change = np.empty(self.n)
-        forces.continuity_of_change(self.x, self.z, du, dw, rho_h, self.mass / rho_h, self.kind,
-                                    self.cells, self.h, change)
-        integrate.leapfrog_density(self.rho, rho_h, self.out[forces.DRHO], change, self.drho_prev,
-                                   self.kind, n, dt, self.rho0, not self.mdbc,
-                                   bool(self.scene.physics.no_tension))
-
     def viscous_operator(self) -> tuple:
         """The laminar operator C of the last evaluation (``implicit.operator``)."""
-        return implicit.operator(self.pairs, self.cells, self.split, self.out[self.nq - 1], self.mass,
+        return implicit.operator(self.pairs, self.cells, self.split, self.out[self.slots.DIAG], self.mass,
                                  self.product_shares)
 
     def _solve_viscous(self, dt: float) -> str:
@@ -289,21 +263,21 @@ class Simulation:
         """rho *= 1 - div(dr) for the last shift dr, with div(dr) summed in this evaluation's
         pair loop, one step after the shift (positions have moved by dt v since, about
         0.01 dp per step on the paper case), limited per step; the shift is then consumed."""
-        shifting.limit_correction(self.rho, self.kind, self.out[forces.DIVDR], self.n_active,
+        shifting.limit_correction(self.rho, self.kind, self.out[self.slots.DIVDR], self.n_active,
                                   self.scene.shift_correction_limit)
         self.shift_dx[:] = 0.0
         self.shift_dz[:] = 0.0
 
     def _relax_volume(self, dt: float):
         """The interior density towards the particles' packing (``packing.relax_density``)."""
-        packing.relax_density(self.rho, self.mass, self.kind, self.out[self.volume_slot],
-                              self.out[forces.GCX], self.out[forces.GCZ], self.n_active,
+        o, sl = self.out, self.slots
+        packing.relax_density(self.rho, self.mass, self.kind, o[sl.VOLC], o[sl.GCX], o[sl.GCZ], self.n_active,
                               alpha_2d(self.h), self.h,
                               self.n_lattice, self.volume_relaxation * self.c0 * dt / self.h)
 
     def _update_dt(self):
-        dt, k, lim = integrate.time_step(self.scene.cfl, self.h, self.amax, self.vmax, self.c0,
-                                         self.nu_max_now, self.scene.cfl_viscous,
+        dt, k, lim = integrate.time_step(self.scene.numerics.cfl, self.h, self.amax, self.vmax, self.c0,
+                                         self.nu_max_now,
                                          viscous_limit=not self.implicit,
                                          cfl_acoustic=self.cfl_acoustic)
         self.info = StepInfo(dt, k, lim)
@@ -311,19 +285,19 @@ class Simulation:
     def _shift(self, dt: float):
         if self.shift_method == "none":
             return
-        sh = self.scene.physics.shifting
+        sh = self.scene.numerics.shifting
         A = self.scene.shifting_coefficient
-        o = self.out
-        gcx, gcz, divr = o[forces.GCX], o[forces.GCZ], o[forces.DIVR]
-        wnx, wnz = o[forces.WNX], o[forces.WNZ]
-        clip = sh.max_shift * self.scene.dp
+        o, sl = self.out, self.slots
+        gcx, gcz, divr = o[sl.GCX], o[sl.GCZ], o[sl.DIVR]
+        wnx, wnz = o[sl.WNX], o[sl.WNZ]
+        clip = MAX_SHIFT * self.scene.dp
         if self.shift_method == "skillen":
             shifting.skillen_shift(self.kind, self.u, self.w, gcx, gcz, divr, wnx, wnz, self.wall_s0,
-                                   self.n_active, A, self.h, dt, sh.surface_threshold, clip,
+                                   self.n_active, A, self.h, dt, SURFACE_THRESHOLD, clip,
                                    sh.min_speed, self.shift_dx, self.shift_dz)
         elif self.shift_method == "lind":
             shifting.free_surface(self.x, self.z, self.kind, gcx, gcz, divr, self.cells,
-                                  self.n_active, self.h, sh.surface_threshold, shifting.SCAN_UPPER,
+                                  self.n_active, self.h, SURFACE_THRESHOLD, shifting.SCAN_UPPER,
                                   self.surface_flag)
             D = 0.5 * A * self.h * self.h
             if sh.near_surface == "tangential":  # the near-surface flags with the normals, one pass
@@ -365,13 +339,9 @@ class Simulation:
         if self.volume_relaxation:
             self._relax_volume(dt)
         o = self.out
-        if self.leapfrog:
-            u0, w0, rho_h = self.u.copy(), self.w.copy(), self.rho.copy()
         integrate.kick(self.u, self.w, self.rho, self.kind, o[forces.AX], o[forces.AZ], o[forces.DRHO],
                        self.drho_prev, self.n_active, dt, self.rho0, not self.mdbc,
-                       bool(s.physics.no_tension))
-        if self.leapfrog:
-            self._leapfrog_density(t + 0.5 * dt, dt, u0, w0, rho_h)
+                       bool(s.numerics.no_tension))
         vw = self.wall_velocities(t + dt)
         integrate.drift(self.x, self.z, self.u, self.w, self.kind, self.wall, self.gx, self.gz,
                         vw, self.moving, 0.5 * dt, self.n)
@@ -428,10 +398,11 @@ class Simulation:
         reason = self._evaluate(self.t)
         if reason:
             raise RuntimeError(reason)
-        names = ("ax", "az", "drho", "gradC_x", "gradC_z", "div_r", "wall_nx", "wall_nz",
-                 "div_dr")[:self.nq - self.implicit]
+        names = {"ax": "AX", "az": "AZ", "drho": "DRHO", "gradC_x": "GCX", "gradC_z": "GCZ", "div_r": "DIVR",
+                 "wall_nx": "WNX", "wall_nz": "WNZ", "div_dr": "DIVDR"}
         inv = self._inverse_order()
-        return {k: self.out[q][inv].copy() for q, k in enumerate(names)}
+        return {k: self.out[getattr(self.slots, q)][inv].copy() for k, q in names.items()
+                if getattr(self.slots, q) >= 0}
 
     def shift_only(self, dt: float) -> None:
         """Apply one shifting displacement (no time integration), as if over a step dt."""

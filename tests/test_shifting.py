@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from solver.build import build_particles
-from solver.forces import WNX, WNZ
+
 from solver.run import run_scene
 from solver.simulation import Simulation
 from tests.conftest import example_scene
@@ -244,7 +244,7 @@ def shifted_thin_film(depth_dp, near_surface):
     fluid = sim.kind[:n] == 0
     return {"sim": sim, "dp": dp, "dx": sim.shift_dx[:n], "dz": sim.shift_dz[:n],
             "near": (sim.near_flag[:n] == 1) & fluid, "surface": (sim.surface_flag[:n] == 1) & fluid,
-            "walled": np.hypot(sim.out[WNX, :n], sim.out[WNZ, :n]) > 0}
+            "walled": np.hypot(sim.out[sim.slots.WNX, :n], sim.out[sim.slots.WNZ, :n]) > 0}
 
 
 @pytest.mark.parametrize("near_surface", ["none", "tangential"])

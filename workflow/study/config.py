@@ -69,9 +69,9 @@ def _message(err) -> str:
     """The schema's message, or for a case mapping that sets what the grid sets, which keys."""
     if err.validator == "required" and not err.absolute_path and "'case'" in err.message:
         return ("'case' is required: the solver-case keys every run shares (docs/conveyor.md); "
-                "case: {} runs SPEC's scheme as written, config/config.yaml's case keys the shipped "
-                "scheme. A file given by --configfile is complete in itself: nothing is taken from "
-                "config/config.yaml")
+                "case: {} runs the paper's case with the shipped scheme (scheme: surge), "
+                "case: {scheme: spec} the paper's scheme as written. A file given by --configfile is "
+                "complete in itself: nothing is taken from config/config.yaml")
     if err.validator == "not" and isinstance(err.instance, dict):
         found = [k for k in GRID_KEYS if k in err.instance]
         if found:
@@ -140,13 +140,8 @@ def realisations(cfg: dict, dp: float, ch: float, shifting: str) -> int:
 
 
 def _merge(base: dict, changes: dict) -> dict:
-    out = copy.deepcopy(base)
-    for k, v in changes.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _merge(out[k], v)
-        else:
-            out[k] = copy.deepcopy(v)
-    return out
+    from solver.schemes import merge
+    return merge(base, changes)
 
 
 def warm_source(cfg: dict, case: Case) -> Case | None:

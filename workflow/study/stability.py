@@ -30,8 +30,10 @@ GUARD_DEFAULTS = {"max_density_deviation": 0.1, "penetration": 0.5}
 MARGINS = ("density_margin", "penetration_margin", "area_drift_margin")
 TIE = 0.02  # worst margins closer than this are not told apart
 SAFE_FRACTION = 0.5  # a survivor is "safe" when every margin stays below this fraction
-SETTINGS = ("dp", "ch", "shifting", "shifting_coefficient", "cfl", "cfl_rule", "coefsound",
+# the swept settings: a case key, or a numerics key by its path in the case's numerics block
+SETTINGS = ("dp", "ch", "shifting", "shifting.coefficient", "cfl", "cfl_rule", "coefsound",
             "density_diffusion", "boundary")
+CASE_LEVEL = ("dp", "ch", "shifting", "coefsound")
 
 
 def detector(status: str, reason: str) -> str:
@@ -77,7 +79,15 @@ def margins(run: xr.Dataset) -> dict[str, float]:
 def case_settings(run: xr.Dataset) -> dict:
     """The swept settings of one run, from its case configuration."""
     case = yaml.safe_load(run.attrs.get("case_yaml", "")) or {}
-    return {k: case.get(k) for k in SETTINGS}
+    numerics = case.get("numerics") or {}
+
+    def numerics_value(path):
+        node = numerics
+        for part in path.split("."):
+            node = node.get(part) if isinstance(node, dict) else None
+        return node
+
+    return {k: case.get(k) if k in CASE_LEVEL else numerics_value(k) for k in SETTINGS}
 
 
 def is_safe(status: str, m: dict) -> bool:

@@ -1,0 +1,59 @@
+"""Named schemes: presets of a conveyor case's numerics, resolved before the case is parsed.
+
+``spec`` is the paper's scheme as docs/scheme.md section 6 writes it (the ``Numerics``
+defaults). ``surge`` is the shipped scheme and every case's default: the departures of
+docs/numerics.md that let the front settle (for a yield-stress fluid, the implicit laminar
+term at C = 0.4 with the volume relaxation). A case's own keys override its preset's.
+"""
+from __future__ import annotations
+
+import copy
+
+DEFAULT_SCHEME = "surge"
+SKILLEN_MIN_SPEED = 0.5  # surge: Skillen's shifting speed at least this fraction of the belt speed
+
+
+def _surge(belt_speed: float, newtonian: bool) -> dict:
+    if not newtonian:  # a yield-stress fluid: the viscosity cap would bind an explicit step
+        return {
+            "start_velocity": "lubrication",
+            "numerics": {
+                "cfl": 0.4,
+                "viscous_update": "implicit",
+                "volume_relaxation": 0.1,
+                "density_diffusion_reference": "column",
+            },
+        }
+    return {
+        "start_velocity": "lubrication",  # the steady film's profile, belt running from t = 0
+        "numerics": {
+            "cfl": 0.6,
+            "cfl_rule": "damping",
+            "viscous_update": "substepped",
+            "viscous_correction": True,
+            "mdbc_velocity": "corrected",
+            "volume_relaxation": 0.1,
+            "density_diffusion_reference": "column",
+            "shifting": {"min_speed": SKILLEN_MIN_SPEED * belt_speed, "near_surface": "tangential"},
+        },
+    }
+
+
+SCHEMES = {"spec": lambda belt_speed, newtonian: {}, "surge": _surge}
+
+
+def preset(name: str, belt_speed: float, newtonian: bool = True) -> dict:
+    """The case keys that scheme ``name`` sets (nested like a case file), for a Newtonian or a
+    Herschel-Bulkley fluid; ``belt_speed`` [m/s] scales the speeds it gives in units of u_b."""
+    return SCHEMES[name](belt_speed, newtonian)
+
+
+def merge(base: dict, changes: dict) -> dict:
+    """``base`` with ``changes`` laid over it, mappings merged key by key."""
+    out = copy.deepcopy(base)
+    for k, v in changes.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
