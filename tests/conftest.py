@@ -29,7 +29,7 @@ def example_scene(name: str, **changes):
     return scene_from_dict(merge(example_dict(name), changes))
 
 
-def periodic_layer(ch: float, physics: dict, viscosity: float = 1.0e-3):
+def periodic_layer(ch: float, numerics: dict, viscosity: float = 1.0e-3):
     """A periodic fluid layer 40 dp deep and long (dp = 1 mm, rho0 = 1000, c0 = 10, no gravity)
     on a 4 dp bed, at rest, sorted into its cells by one evaluation."""
     from solver.simulation import Simulation
@@ -39,21 +39,18 @@ def periodic_layer(ch: float, physics: dict, viscosity: float = 1.0e-3):
         "fluid": {"density": 1000.0, "viscosity": viscosity, "blocks": [{"x": [0.0, L], "z": [0.0, H]}]},
         "walls": [{"name": "bed", "x": [0.0, L], "z": [-4 * dp, 0.0]}],
         "gravity": [0.0, 0.0], "sound": {"c0": 10.0}, "periodic_x": [0.0, L],
-        "physics": physics, "time": {"end": 1.0, "output_interval": 1.0}}))
+        "numerics": numerics, "time": {"end": 1.0, "output_interval": 1.0}}))
     assert sim._evaluate(0.0) == ""
     return sim
 
 
 def coarse_conveyor_case(**changes):
-    """dp = 2.25 mm, Ch = 2.2: the default campaign's scheme at its coarsest grid and largest Ch,
-    where nu / (c0 h) = 0.19 (docs/numerics.md, "What sets the coarse edge")."""
+    """dp = 2.25 mm, Ch = 2.2: the shipped scheme (surge) at the default campaign's coarsest grid
+    and largest Ch, where nu / (c0 h) = 0.19."""
     from solver.conveyor import case_from_dict
     return case_from_dict({
         "name": "coarse", "dp": 2.25e-3, "ch": 2.2, "shifting": "skillen",
-        "shift_min_speed": 0.5, "viscous_correction": True, "volume_relaxation": 0.1,
-        "density_diffusion_reference": "column", "start_velocity": "lubrication",
-        "viscous_update": "substepped", "normalising_depth": 0.0186, "start_depth": "theory",
-        **changes})
+        "normalising_depth": 0.0186, "start_depth": "theory", **changes})
 
 
 def worst_density_deviation(sim, t_end: float, t_from: float = 0.2) -> float:

@@ -136,7 +136,7 @@ def test_rule_does_not_bind_on_the_shipped_grids(config):
         scene = build_scene(case_from_dict(d))
         assert scene.cfl_acoustic == d["cfl"], case.id
         bound = acoustic_edge.MARGIN * acoustic_edge.edge(scene.ch, scene.acoustic_damping_ratio,
-                                                          scene.physics.density_diffusion)
+                                                          scene.numerics.density_diffusion)
         assert bound > d["cfl"], case.id
 
 
@@ -154,7 +154,7 @@ def test_rule_refuses_what_it_cannot_bound():
     with pytest.raises(SceneError, match="cfl_rule: 'auto' is not one of fixed, damping"):
         example_scene("couette", cfl_rule="auto")
     with pytest.raises(SceneError, match="density_update: leapfrog"):  # no damping at all
-        example_scene("couette", cfl_rule="damping", physics={"density_diffusion": None},
+        example_scene("couette", cfl_rule="damping", numerics={"density_diffusion": None},
                       fluid={"viscosity": 1e-9})
     with pytest.raises(SceneError, match="needs one viscosity"):
         example_scene("hb_film", cfl_rule="damping")

@@ -153,7 +153,7 @@ def test_case_errors_name_the_key():
         paper(fluid_length=10.0)
     with pytest.raises(SceneError, match="case: unknown key.*shiftng"):
         paper(shiftng="lind")
-    with pytest.raises(SceneError, match="physics.shifting.method"):
+    with pytest.raises(SceneError, match="numerics.shifting.method"):
         paper(shifting="magic")
     with pytest.raises(SceneError, match="case.shift_min_speed"):
         paper(shift_min_speed=-0.5)
@@ -165,9 +165,9 @@ def test_shift_min_speed_is_a_fraction_of_the_belt_speed_for_skillen_only():
     """One campaign grid holds both methods: the floor reaches skillen's scene as
     shift_min_speed u_b [m/s] and is not passed to lind, whose shift does not scale with |u|."""
     skillen = build_scene(paper(shifting="skillen", shift_min_speed=0.5, dp=4.0e-3))
-    assert skillen.physics.shifting.min_speed == pytest.approx(0.5 * 0.075)
+    assert skillen.numerics.shifting.min_speed == pytest.approx(0.5 * 0.075)
     lind = build_scene(paper(shifting="lind", shift_min_speed=0.5, dp=4.0e-3))
-    assert lind.physics.shifting.min_speed == 0.0
+    assert lind.numerics.shifting.min_speed == 0.0
 
 
 def test_shift_near_surface_reaches_lind_only_and_is_checked():
@@ -175,10 +175,10 @@ def test_shift_near_surface_reaches_lind_only_and_is_checked():
     div r): passed to lind's scene, not to skillen's, so one grid holds both; a wrong value is
     refused naming the key and the allowed values."""
     lind = build_scene(paper(shifting="lind", shift_near_surface="tangential", dp=4.0e-3))
-    assert lind.physics.shifting.near_surface == "tangential"
+    assert lind.numerics.shifting.near_surface == "tangential"
     skillen = build_scene(paper(shifting="skillen", shift_near_surface="tangential", dp=4.0e-3))
-    assert skillen.physics.shifting.near_surface == "none"
-    assert build_scene(paper(shifting="lind", dp=4.0e-3)).physics.shifting.near_surface == "none"
+    assert skillen.numerics.shifting.near_surface == "none"
+    assert build_scene(paper(shifting="lind", dp=4.0e-3)).numerics.shifting.near_surface == "none"
     with pytest.raises(SceneError, match="case.shift_near_surface: 'normal' is not one of none, tangential"):
         build_scene(paper(shifting="skillen", shift_near_surface="normal", dp=4.0e-3))
 
@@ -340,8 +340,8 @@ def test_a_resumed_run_takes_its_start_from_the_checkpoint(tmp_path, monkeypatch
 
 
 def test_no_tension_is_passed_to_the_scene():
-    assert build_scene(coarse_conveyor_case()).physics.no_tension is False
-    assert build_scene(coarse_conveyor_case(no_tension=True)).physics.no_tension is True
+    assert build_scene(coarse_conveyor_case()).numerics.no_tension is False
+    assert build_scene(coarse_conveyor_case(no_tension=True)).numerics.no_tension is True
     with pytest.raises(SceneError, match="case.no_tension"):
         coarse_conveyor_case(no_tension="yes")
 

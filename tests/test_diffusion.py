@@ -12,7 +12,7 @@ from tests.conftest import example_scene
 
 def sine_channel(delta, eps=1e-3):
     """Channel at rest with rho = rho0 (1 + eps sin(k x)); returns (sim, k)."""
-    scene = example_scene("channel", physics={"density_diffusion": delta})
+    scene = example_scene("channel", numerics={"density_diffusion": delta})
     parts = build_particles(scene)
     L = scene.periodic_x[1] - scene.periodic_x[0]
     k = 2 * math.pi / L
@@ -60,8 +60,8 @@ def diffusion_rate_at_rest(reference, dp, ch):
     """|drho/dt| / rho of the diffusion term alone on the hydrostatic tank at rest, and the
     bulk rate SPEC's rho^H leaves, 11 delta h g^2 / c0^3 (see the next test)."""
     phys = {"density_diffusion_reference": reference}
-    on = Simulation(example_scene("hydrostatic", dp=dp, ch=ch, physics=phys))
-    off = Simulation(example_scene("hydrostatic", dp=dp, ch=ch, physics={"density_diffusion": None}))
+    on = Simulation(example_scene("hydrostatic", dp=dp, ch=ch, numerics=phys))
+    off = Simulation(example_scene("hydrostatic", dp=dp, ch=ch, numerics={"density_diffusion": None}))
     d_on, d_off = on.derivatives(), off.derivatives()
     s = on.snapshot()
     fl = s["kind"] == 0

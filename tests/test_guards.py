@@ -61,7 +61,7 @@ def test_particle_leaves_domain():
 def test_particle_crosses_wall():
     # plain DBC, soft fluid, fast impact: particles are pushed through the thin bed
     scene = example_scene("hydrostatic", sound={"coefsound": 2.0, "depth": 0.05},
-                          physics={"boundary": "dbc"},
+                          numerics={"boundary": "dbc"},
                           guards={"max_density_deviation": 10.0},
                           fluid={"blocks": [{"x": [0.0, 0.1], "z": [0.0, 0.05], "velocity": [0.0, -3.0]}]})
     assert_clean_divergence(run(scene), "crossed a wall")

@@ -1,4 +1,4 @@
-"""The implicit laminar term (physics.viscous_update: implicit, solver/implicit.py): the linear
+"""The implicit laminar term (numerics.viscous_update: implicit, solver/implicit.py): the linear
 system it solves, and the flows it must reproduce at steps far beyond the viscous limit."""
 import numpy as np
 import pytest
@@ -14,7 +14,7 @@ L_CHANNEL = 1.0e-3
 def jittered_couette(jitter=0.2, seed=1):
     """The Couette channel's particles moved by up to ``jitter`` dp, with a random velocity
     field, evaluated once with the implicit update on."""
-    sc = example_scene("couette", physics={"viscous_update": "implicit"})
+    sc = example_scene("couette", numerics={"viscous_update": "implicit"})
     p = build_particles(sc)
     fl = p.kind == 0
     rng = np.random.default_rng(seed)
@@ -158,8 +158,8 @@ def test_conjugate_gradients_started_from_the_last_correction_reach_the_same_sol
 def test_a_viscosity_wrong_name_is_refused_with_its_key():
     from solver.scene import SceneError, scene_from_dict
     d = example_scene("couette").to_dict()
-    d["physics"]["viscous_update"] = "crank-nicolson"
-    with pytest.raises(SceneError, match=r"physics.viscous_update: 'crank-nicolson' is not one of "
+    d["numerics"]["viscous_update"] = "crank-nicolson"
+    with pytest.raises(SceneError, match=r"numerics.viscous_update: 'crank-nicolson' is not one of "
                                          r"explicit, implicit, substepped, auto, auto_substepped"):
         scene_from_dict(d)
 
@@ -191,20 +191,20 @@ def test_the_run_records_which_viscous_update_auto_chose():
     acoustic one, so ``auto`` runs it implicitly, and the output says so."""
     from solver.output import to_dataset
     from solver.run import run_scene
-    sc = example_scene("couette", physics={"viscous_update": "auto"}, time={"end": 2e-4, "output_interval": 1e-4})
+    sc = example_scene("couette", numerics={"viscous_update": "auto"}, time={"end": 2e-4, "output_interval": 1e-4})
     assert sc.implicit_viscosity
     res = run_scene(sc)
     assert res.status == "completed" and res.steps > 0
     attrs = to_dataset(res).attrs
     assert attrs["viscous_update"] == "implicit" and attrs["cg_iterations"] > 0
-    sc = example_scene("couette", physics={"viscous_update": "auto"}, cfl_viscous=1e3)
+    sc = example_scene("couette", numerics={"viscous_update": "auto"}, cfl_viscous=1e3)
     assert not sc.implicit_viscosity
     # auto_substepped: the same choice, with RKC stages instead of CG
-    sc = example_scene("couette", physics={"viscous_update": "auto_substepped"},
+    sc = example_scene("couette", numerics={"viscous_update": "auto_substepped"},
                        time={"end": 2e-4, "output_interval": 1e-4})
     attrs = to_dataset(run_scene(sc)).attrs
     assert attrs["viscous_update"] == "substepped" and attrs["rkc_stages"] > 0 and attrs["cg_iterations"] == 0
-    sc = example_scene("couette", physics={"viscous_update": "auto_substepped"}, cfl_viscous=1e3)
+    sc = example_scene("couette", numerics={"viscous_update": "auto_substepped"}, cfl_viscous=1e3)
     assert not sc.implicit_viscosity and sc.viscous_update_used == "explicit"
 
 
@@ -217,7 +217,7 @@ def test_couette_reaches_the_exact_steady_profile_at_twenty_times_the_viscous_li
     one. Measured in 41 steps: L2 error 0.0013 % of U0 (implicit, 19.3 CG iterations a step),
     0.0003 % (sub-stepped, 6.9 RKC stages a step; with the damping 0.05 instead of 0.4 it was
     0.25 %: the stiff modes the start excites then lose only 5 % a step)."""
-    sc = example_scene("couette", physics={"viscous_update": update, "mdbc_velocity": "corrected"},
+    sc = example_scene("couette", numerics={"viscous_update": update, "mdbc_velocity": "corrected"},
                        time={"end": 1.2, "output_interval": 1.2})
     sim = Simulation(sc)
     while sim.t < sc.time.end - 1e-12:
@@ -243,7 +243,7 @@ def test_at_the_explicit_step_the_implicit_update_matches_the_exact_start_up(upd
     0.093, 0.737, 1.214, tests/test_validation.py); bounds are those plus 25 %, as there.
     Backward Euler lags where forward Euler leads, and the wall particles' velocity change is
     approximated by the mirror of the fluid's (solver/implicit.py)."""
-    sc = example_scene("poiseuille", physics={"viscous_update": update})
+    sc = example_scene("poiseuille", numerics={"viscous_update": update})
     sim = Simulation(sc)
     dt = sc.cfl * sc.h ** 2 / sc.nu
     F = sc.gravity[0]
@@ -276,7 +276,7 @@ def test_a_pair_list_that_overflows_is_widened_and_the_evaluation_repeated():
 def test_the_memory_estimate_covers_what_the_implicit_update_allocates(update):
     """implicit.bytes_per_particle, which the scene's memory check adds, against the arrays'
     own sizes (plus the fixed 1024 pairs of slack per thread), with both updates."""
-    sc = example_scene("couette", physics={"viscous_update": update})
+    sc = example_scene("couette", numerics={"viscous_update": update})
     sim = Simulation(sc, build_particles(sc))
     substeps = update == "substepped"
     assert sim.substeps == substeps
@@ -341,7 +341,7 @@ def fast_scheme_film(update: str, dp: float = 1.0e-3, ch: float = 1.8):
         "film", dp=dp, ch=ch, periodic_x=[0.0, L],
         fluid={"blocks": [{"x": [0.0, L], "z": [0.0, H]}]},
         walls=[{"name": "bed", "x": [0.0, L], "z": [-4 * dp, 0.0]}],
-        physics={"viscous_update": update, "viscous_correction": True, "viscous_normalisation": True,
+        numerics={"viscous_update": update, "viscous_correction": True, "viscous_normalisation": True,
                  "mdbc_velocity": "corrected", "volume_relaxation": 0.1,
                  "density_diffusion_reference": "column", "shifting": {"method": "skillen"}})
 

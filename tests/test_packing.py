@@ -15,7 +15,7 @@ BETA = 0.1
 def channel_sim(volume_scale: float = 1.0) -> Simulation:
     """The closed channel at rest with lind shifting and the relaxation; the fluid particles'
     volumes m / rho scaled by ``volume_scale`` (their spacing unchanged)."""
-    scene = example_scene("channel", physics={"shifting": {"method": "lind"},
+    scene = example_scene("channel", numerics={"shifting": {"method": "lind"},
                                               "volume_relaxation": BETA})
     parts = build_particles(scene)
     parts.mass[parts.kind == 0] *= volume_scale
@@ -71,7 +71,7 @@ def test_a_free_surface_is_not_taken_for_loose_packing():
     the top one within 2h) have C down to 0.75 and keep their density; below them the
     lattice is at C_0 but for the particles next to the walls, whose mDBC densities make C
     up to 0.3 % low (measured), so nothing moves by more than lambda 0.4 %."""
-    scene = example_scene("hydrostatic", physics={"shifting": {"method": "lind"},
+    scene = example_scene("hydrostatic", numerics={"shifting": {"method": "lind"},
                                                   "volume_relaxation": BETA})
     sim = Simulation(scene)
     f = sim.kind == 0
@@ -90,4 +90,4 @@ def test_a_free_surface_is_not_taken_for_loose_packing():
 ])
 def test_bad_settings_name_the_key(physics, message):
     with pytest.raises(SceneError, match=f"physics.volume_relaxation: .*{message}"):
-        example_scene("channel", physics=physics)
+        example_scene("channel", numerics=physics)

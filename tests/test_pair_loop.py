@@ -27,7 +27,7 @@ def disordered_layer(ch: float, seed: int = 3) -> Simulation:
         "fluid": {"density": 1000.0, "viscosity": 0.05, "blocks": [{"x": [0.0, LENGTH], "z": [0.0, DEPTH]}]},
         "walls": [{"name": "bed", "x": [0.0, LENGTH], "z": [-4 * DP, 0.0], "velocity": [0.1, 0.0]}],
         "gravity": [0.0, 0.0], "sound": {"c0": 10.0}, "periodic_x": [0.0, LENGTH],
-        "physics": {"density_diffusion": 0.1, "shifting": {"method": "skillen"}},
+        "numerics": {"density_diffusion": 0.1, "shifting": {"method": "skillen"}},
         "time": {"end": 1.0, "output_interval": 1.0}}))
     rng = np.random.default_rng(seed)
     fl = sim.kind == 0

@@ -23,8 +23,8 @@ def test_examples_are_valid_and_round_trip(examples_dir, name):
 
 
 def test_unknown_key_named_with_allowed_keys():
-    msg = err({"physics": {"shiftng": {"method": "lind"}}})
-    assert "physics" in msg and "shiftng" in msg and "shifting" in msg
+    msg = err({"numerics": {"shiftng": {"method": "lind"}}})
+    assert "numerics" in msg and "shiftng" in msg and "shifting" in msg
 
 
 def test_wrong_type_named():
@@ -42,15 +42,15 @@ def test_impossible_values():
     assert "dp: must be a positive" in err({"dp": 0.0})
     assert "dp: must be a positive" in err({"dp": -1e-3})
     assert "cfl" in err({"cfl": -0.2})
-    assert "physics.shifting.method" in err({"physics": {"shifting": {"method": "magic"}}})
-    assert "none, skillen, lind" in err({"physics": {"shifting": {"method": "magic"}}})
-    assert "physics.boundary" in err({"physics": {"boundary": "slip"}})
+    assert "physics.shifting.method" in err({"numerics": {"shifting": {"method": "magic"}}})
+    assert "none, skillen, lind" in err({"numerics": {"shifting": {"method": "magic"}}})
+    assert "physics.boundary" in err({"numerics": {"boundary": "slip"}})
     assert "physics.density_update: 'verlet' is not one of explicit, leapfrog" in err(
-        {"physics": {"density_update": "verlet"}})
+        {"numerics": {"density_update": "verlet"}})
     assert "physics.shifting.min_speed: must be a finite number >= 0" in err(
-        {"physics": {"shifting": {"method": "skillen", "min_speed": -0.1}}})
+        {"numerics": {"shifting": {"method": "skillen", "min_speed": -0.1}}})
     assert "applies to method skillen only" in err(
-        {"physics": {"shifting": {"method": "lind", "min_speed": 0.05}}})
+        {"numerics": {"shifting": {"method": "lind", "min_speed": 0.05}}})
     assert "fluid.blocks[0].x" in err({"fluid": {"blocks": [{"x": [1e-3, 0.0], "z": [0.0, 1e-3]}]}})
 
 

@@ -20,7 +20,7 @@ def moving_channel(method, **physics):
     for w in walls:
         w["velocity"], w["moving"] = [U, 0.0], True
     return example_scene("channel", walls=walls,
-                         physics={"shifting": {"method": method, **physics}})
+                         numerics={"shifting": {"method": method, **physics}})
 
 
 def disorder(x, z, kind, period, dp, among=None):
@@ -85,7 +85,7 @@ def test_shifting_reduces_disorder(method):
 
 
 def disordered_channel_at_rest(min_speed):
-    scene = example_scene("channel", physics={"shifting": {"method": "skillen", "density_correction": False,
+    scene = example_scene("channel", numerics={"shifting": {"method": "skillen", "density_correction": False,
                                                             "min_speed": min_speed}})
     parts = build_particles(scene)
     f = parts.kind == 0
@@ -129,7 +129,7 @@ def test_skillen_speed_floor_orders_the_interior_of_fluid_at_rest():
 def test_shifting_off_leaves_disorder():
     """Control for the test above: with method none the same shifting calls move nothing."""
     scene = example_scene("channel")
-    assert scene.physics.shifting.method == "none"
+    assert scene.numerics.shifting.method == "none"
     parts = build_particles(scene)
     f = parts.kind == 0
     parts.x[f] += np.random.default_rng(7).uniform(-0.2, 0.2, f.sum()) * scene.dp
@@ -145,7 +145,7 @@ def test_shifting_off_leaves_disorder():
 def test_density_correction_follows_the_volume_change_of_the_shift():
     """rho *= 1 - div(dr): zero for a uniform shift, -2 eps rho for dr = eps r in 2D.
     div(dr) of the pending shift is summed in the next evaluation's pair loop."""
-    scene = example_scene("channel", physics={"shifting": {"method": "skillen"}})
+    scene = example_scene("channel", numerics={"shifting": {"method": "skillen"}})
     H = scene.fluid.blocks[0].z[1]
 
     def div(fx, fz):
@@ -171,7 +171,7 @@ def test_density_correction_follows_the_volume_change_of_the_shift():
 def film_inflation(method, correction, t_end=0.5, near_surface="none"):
     """Relative growth of the film's free-surface height over t_end (periodic film)."""
     from solver.probes import FieldSampler
-    scene = example_scene("film", physics={"shifting": {"method": method, "density_correction": correction,
+    scene = example_scene("film", numerics={"shifting": {"method": method, "density_correction": correction,
                                                         "near_surface": near_surface}},
                           time={"end": t_end, "output_interval": t_end})
     sim = Simulation(scene)
@@ -192,7 +192,7 @@ def test_skillen_without_density_correction_inflates_a_film_and_with_it_does_not
 def rest_density_error(limit, steps=1200):
     """max |rho/rho0 - 1| of a closed channel at rest after ``steps`` steps of lind with the
     density correction and the given per-step limit (None: unlimited); '' or the reason."""
-    scene = example_scene("channel", physics={"shifting": {"method": "lind", "correction_limit": limit}},
+    scene = example_scene("channel", numerics={"shifting": {"method": "lind", "correction_limit": limit}},
                           time={"end": 1.0, "output_interval": 1.0})
     sim = Simulation(scene)
     for _ in range(steps):
@@ -208,7 +208,7 @@ def test_lind_density_correction_is_limited_per_step():
     """Round-off in a channel at rest: a full per-step correction erases the compression the
     pressure needs and the density error grows to the 10 % guard (measured: step 454); the
     default limit of 1e-3 per step keeps it below 0.5 % (measured: 0.19 %)."""
-    sim = Simulation(example_scene("channel", physics={"shifting": {"method": "lind"}}))
+    sim = Simulation(example_scene("channel", numerics={"shifting": {"method": "lind"}}))
     assert sim.scene.shift_correction_limit == 1e-3
     err, reason = rest_density_error(1e-3)
     assert reason == "" and err < 0.005, (err, reason)
@@ -231,7 +231,7 @@ def shifted_thin_film(depth_dp, near_surface):
     the flags, in the simulation's order, of its active particles."""
     dp = example_scene("film").dp
     scene = example_scene("film", fluid={"blocks": [{"x": [0.0, 20 * dp], "z": [0.0, depth_dp * dp]}]},
-                          physics={"shifting": {"method": "lind", "density_correction": False,
+                          numerics={"shifting": {"method": "lind", "density_correction": False,
                                                 "near_surface": near_surface}})
     parts = build_particles(scene)
     f = parts.kind == 0

@@ -35,7 +35,7 @@ def test_hydrostatic_layer_pressure_and_no_penetration():
 
 def startup_channel_errors(name, velocity, exact_u):
     """L2 error at t = 0.0225, 0.1125, 0.225 s of a start-up channel flow (20 particles across)."""
-    scene = example_scene(name, physics={"mdbc_velocity": velocity})
+    scene = example_scene(name, numerics={"mdbc_velocity": velocity})
     res = run_scene(scene)
     assert res.status == "completed", res.reason
     assert scene.fluid.blocks[0].z[1] / scene.dp >= 20

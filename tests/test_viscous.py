@@ -14,7 +14,7 @@ def linear_shear_residual(correction: bool, jitter: float) -> tuple[np.ndarray, 
     """Couette channel at rest pressure (rho = rho0) with u = U0 z / L on fluid particles
     moved by up to ``jitter`` dp: its exact viscous acceleration is zero. Returns a_x of the
     interior (2.5 h from the walls) and the first-order error scale nu U0 / (L dp)."""
-    sc = example_scene("couette", physics={"viscous_correction": correction, "density_diffusion": None})
+    sc = example_scene("couette", numerics={"viscous_correction": correction, "density_diffusion": None})
     p = build_particles(sc)
     fl = p.kind == 0
     L, U0 = 1.0e-3, sc.walls[1].velocity[0]
@@ -53,7 +53,7 @@ def quadratic_flow_response(normalised: bool, jitter: float, ch: float = 1.5) ->
     on fluid particles moved by up to ``jitter`` dp: the corrected laminar term of the
     interior (2.5 h from the walls) over nu u''. Evaluated twice, so that the normalised
     term takes the factors of an evaluation at the same state."""
-    sc = example_scene("couette", ch=ch, physics={"viscous_correction": True, "density_diffusion": None,
+    sc = example_scene("couette", ch=ch, numerics={"viscous_correction": True, "density_diffusion": None,
                                                   "viscous_normalisation": normalised})
     p = build_particles(sc)
     fl = p.kind == 0
@@ -100,7 +100,7 @@ def test_corrected_ghost_velocity_stays_within_the_fluid_velocities_it_interpola
     surface cuts as well as the wall: the upstream wall's contact line of the conveyor at
     Ch 2.2 went into tension with it). It is limited to that range: with fluid velocities
     in [0, U] (a step near each wall) every ghost value, 2 v_wall - v_b, lies in [0, U]."""
-    sc = example_scene("couette", physics={"mdbc_velocity": "corrected"})
+    sc = example_scene("couette", numerics={"mdbc_velocity": "corrected"})
     p = build_particles(sc)
     fl = p.kind == 0
     U = 1.0e-3  # a step in each component: a line fitted across it overshoots at the edge
@@ -125,7 +125,7 @@ def test_corrected_ghost_velocity_fades_to_shepards_where_the_support_is_lopside
     value is biased there), the side walls' values differ from Shepard's at mid-depth and equal
     them within h / 2 of the free surface."""
     def wall_velocities(method):
-        sc = example_scene("hydrostatic", physics={"mdbc_velocity": method})
+        sc = example_scene("hydrostatic", numerics={"mdbc_velocity": method})
         p = build_particles(sc)
         fl = p.kind == 0
         p.u[fl] = 1.0e-3 * p.x[fl] / 0.1
@@ -150,8 +150,8 @@ def test_normalisation_needs_the_correction_and_resumes_exactly():
     part of the state)."""
     from solver.scene import SceneError
     with pytest.raises(SceneError, match="viscous_normalisation.*viscous_correction: true"):
-        example_scene("couette", physics={"viscous_normalisation": True})
-    sc = example_scene("couette", physics={"viscous_correction": True, "viscous_normalisation": True})
+        example_scene("couette", numerics={"viscous_normalisation": True})
+    sc = example_scene("couette", numerics={"viscous_correction": True, "viscous_normalisation": True})
     p = build_particles(sc)
     fl = p.kind == 0
     p.x[fl] += np.random.default_rng(3).uniform(-0.1, 0.1, fl.sum()) * sc.dp
