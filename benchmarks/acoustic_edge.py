@@ -44,15 +44,20 @@ def predict(scene) -> tuple[float, float, float, float]:
     return r, delta, scene.cfl_acoustic, acoustic_edge.edge(scene.ch, r, delta)
 
 
-def outcome(case: Path, out: Path, name: str, sets: list[str], to: float) -> str:
-    """Run one case; its status as one line."""
-    import xarray as xr
-    path = out / f"{name}.nc"
+def run(case: Path, out: Path, name: str, sets: list[str], to: float) -> Path | str:
+    """Run one case: its NetCDF, or why the solver refused it."""
     try:
-        common.front(case, ["steady.stop=false", f"steady.max_time={to:g}", *sets], path, 1)
+        return common.front(case, ["steady.stop=false", f"steady.max_time={to:g}", *sets], out / f"{name}.nc", 1)
     except Exception as exc:  # a case the solver refuses: the row says so
         return f"failed: {exc}"
-    with xr.open_dataset(path) as ds:
+
+
+def outcome(result: Path | str) -> str:
+    """A run's status as one line (read in one thread: the NetCDF library is not thread-safe)."""
+    import xarray as xr
+    if isinstance(result, str):
+        return result
+    with xr.open_dataset(result) as ds:
         status, t = ds.attrs["status"], float(ds.attrs["simulated_time_s"])
     return f"guard at {t:.2f} s" if status == "diverged" else f"held to {t:.2f} s"
 
@@ -73,7 +78,8 @@ def main(argv=None) -> int:
     outcomes = [""] * len(runs)
     if not a.predict:
         with ThreadPoolExecutor(a.jobs) as pool:
-            outcomes = list(pool.map(lambda run: outcome(a.case, a.out, run[0], run[1], a.to), runs))
+            results = list(pool.map(lambda r: run(a.case, a.out, r[0], r[1], a.to), runs))
+        outcomes = [outcome(r) for r in results]
     table, ratios = [], []
     for (name, scene), result in zip(rows, outcomes):
         r, delta, c, c_star = predict(scene)
