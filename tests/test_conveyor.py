@@ -105,43 +105,72 @@ def test_start_falls_back_to_h_n_when_the_film_stops():
     does not run the film at all."""
     from solver.front import start_flux_ratio
 
-    r, note = start_flux_ratio(paper(dp=4.0e-3, ch=1.5, cfl=5.0), None)
+    r, note = start_flux_ratio(paper(dp=4.0e-3, ch=1.5, numerics={"cfl": 5.0}), None)
     assert r == 1.0 and note.startswith("theory: h_n, because the film stopped")
     r, note = start_flux_ratio(paper(start="block"), None)
     assert math.isnan(r) and "not used" in note
 
 
-def test_fast_example_is_the_paper_case_with_its_documented_settings():
-    """examples/conveyor_fast.yaml differs from conveyor.yaml only in the settings that
-    docs/conveyor.md measures ("A steady answer in two minutes"; its 1 s average: "Every span, a 1 s
-    average"; lind's tangential shift near the surface: docs/numerics.md, "Lind near the free
-    surface"), and builds a valid scene."""
+def test_fast_example_is_the_paper_case_with_the_shipped_scheme():
+    """examples/conveyor_fast.yaml differs from conveyor.yaml (scheme: spec) only in its name,
+    shifting method, scheme (the default, surge) and steady window, and builds a valid scene with
+    the surge preset's numerics."""
     with open(EXAMPLES / "conveyor.yaml") as fh:
         paper_d = yaml.safe_load(fh)
     with open(EXAMPLES / "conveyor_fast.yaml") as fh:
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
-    assert changed == {"name", "shifting", "shift_min_speed", "shift_near_surface", "viscous_correction",
-                       "viscous_normalisation", "mdbc_velocity", "start_velocity", "cfl", "cfl_rule",
-                       "cfl_viscous", "viscous_update", "volume_relaxation", "density_diffusion_reference",
-                       "steady"}
-    # the fast example averages over 1 s, and from min_time 2 s: the start's transient measured
-    # at its dp (docs/conveyor.md, "Steady state and averaging"; the default 4 s is for coarser dp)
+    assert changed == {"name", "shifting", "scheme", "steady"}
     own = ("max_time", "average", "min_time")
     assert {k: v for k, v in fast_d["steady"].items() if k not in own} == \
         {k: v for k, v in paper_d["steady"].items() if k not in own}
     assert fast_d["steady"]["average"] == 1.0
     assert fast_d["steady"]["min_time"] == 2.0 and fast_d["dp"] <= 1.0e-3
     fast = case_from_dict(fast_d)
-    assert (fast.shifting, fast.viscous_correction, fast.start_velocity) == ("skillen", True, "lubrication")
-    assert (fast.cfl, fast.cfl_viscous, fast.viscous_update) == (0.6, 0.2, "substepped")
-    assert fast.cfl_rule == "damping" and build_scene(fast).cfl_acoustic == 0.6  # the rule does not bind
-    assert fast.shift_min_speed == 0.5
-    assert fast.shift_near_surface == "tangential"  # lind's, when the example runs with shifting=lind
-    assert (fast.volume_relaxation, fast.density_diffusion_reference) == (0.1, "column")
-    assert (fast.viscous_normalisation, fast.mdbc_velocity) == (True, "corrected")
+    n = fast.numerics
+    assert (fast.scheme, fast.shifting, n.viscous_correction, fast.start_velocity) == \
+        ("surge", "skillen", True, "lubrication")
+    assert (n.cfl, n.viscous_update) == (0.6, "substepped")
+    assert n.cfl_rule == "damping" and build_scene(fast).cfl_acoustic == 0.6  # the rule does not bind
+    assert n.shifting.min_speed == pytest.approx(0.5 * fast.belt.speed)
+    assert n.shifting.near_surface == "tangential"  # lind's, when the example runs with shifting=lind
+    assert (n.volume_relaxation, n.density_diffusion_reference) == (0.1, "column")
+    assert n.mdbc_velocity == "corrected"
     assert fast.h_n == paper().h_n
     build_scene(replace(fast, dp=4.0e-3, ch=1.5))
+
+
+def test_a_case_of_only_dp_ch_and_shifting_runs_the_shipped_scheme():
+    """The surge preset is every case's default: a case file with only dp, ch and shifting
+    builds the scene of examples/conveyor_fast.yaml at that dp (but for its name and the run's
+    length), and scheme: spec with no other key the scene of examples/conveyor.yaml."""
+    with open(EXAMPLES / "conveyor_fast.yaml") as fh:
+        fast_d = yaml.safe_load(fh)
+    bare = build_scene(case_from_dict({"dp": 1.0e-3, "ch": 1.8, "shifting": "skillen"})).to_dict()
+    fast = build_scene(case_from_dict(fast_d)).to_dict()
+    for d in (bare, fast):
+        d.pop("name"), d.pop("time")
+    assert bare == fast
+    with open(EXAMPLES / "conveyor.yaml") as fh:
+        spec_d = yaml.safe_load(fh)
+    spec = build_scene(case_from_dict(spec_d)).to_dict()
+    bare_spec = build_scene(case_from_dict({"dp": 1.0e-3, "ch": 1.8, "shifting": "lind", "scheme": "spec"})).to_dict()
+    for d in (spec, bare_spec):
+        d.pop("name"), d.pop("time")
+    assert spec == bare_spec
+
+
+def test_a_preset_key_is_overridden_by_the_case_and_old_flat_keys_say_where_they_live():
+    c = paper(numerics={"cfl": 0.3})
+    assert c.numerics.cfl == 0.3 and c.numerics.cfl_rule == "fixed"  # the rest stays spec's
+    s = case_from_dict({"dp": 4.0e-3, "ch": 1.5, "shifting": "skillen", "numerics": {"cfl": 0.4}})
+    assert s.numerics.cfl == 0.4 and s.numerics.viscous_correction  # the rest stays surge's
+    with pytest.raises(SceneError, match="case.cfl: now numerics.cfl"):
+        paper(cfl=0.4)
+    with pytest.raises(SceneError, match="case.scheme: 'fast' is not one of spec, surge"):
+        paper(scheme="fast")
+    with pytest.raises(SceneError, match="case.numerics.shifting.method"):
+        paper(numerics={"shifting": {"method": "skillen"}})
 
 
 def test_case_errors_name_the_key():
@@ -153,34 +182,24 @@ def test_case_errors_name_the_key():
         paper(fluid_length=10.0)
     with pytest.raises(SceneError, match="case: unknown key.*shiftng"):
         paper(shiftng="lind")
-    with pytest.raises(SceneError, match="numerics.shifting.method"):
+    with pytest.raises(SceneError, match="case.shifting: 'magic' is not one of none, skillen, lind"):
         paper(shifting="magic")
-    with pytest.raises(SceneError, match="case.shift_min_speed"):
-        paper(shift_min_speed=-0.5)
+    with pytest.raises(SceneError, match="numerics.shifting.min_speed"):
+        paper(numerics={"shifting": {"min_speed": -0.5}})
     with pytest.raises(SceneError, match="case.steady.velocity: no longer a key.*front_velocity"):
         paper(steady={"window": 1.0, "velocity": 0.02})
 
 
-def test_shift_min_speed_is_a_fraction_of_the_belt_speed_for_skillen_only():
-    """One campaign grid holds both methods: the floor reaches skillen's scene as
-    shift_min_speed u_b [m/s] and is not passed to lind, whose shift does not scale with |u|."""
-    skillen = build_scene(paper(shifting="skillen", shift_min_speed=0.5, dp=4.0e-3))
-    assert skillen.numerics.shifting.min_speed == pytest.approx(0.5 * 0.075)
-    lind = build_scene(paper(shifting="lind", shift_min_speed=0.5, dp=4.0e-3))
-    assert lind.numerics.shifting.min_speed == 0.0
-
-
-def test_shift_near_surface_reaches_lind_only_and_is_checked():
-    """The tangential near-surface shift is lind's (skillen scales its shift near the surface by
-    div r): passed to lind's scene, not to skillen's, so one grid holds both; a wrong value is
-    refused naming the key and the allowed values."""
-    lind = build_scene(paper(shifting="lind", shift_near_surface="tangential", dp=4.0e-3))
+def test_the_surge_speed_floor_is_half_the_belt_speed_and_each_method_reads_its_own_key():
+    """One campaign grid holds both methods: the preset's Skillen speed floor is 0.5 u_b [m/s]
+    of the case's own belt, and a wrong near-surface value is refused naming the key."""
+    fast = case_from_dict({"dp": 4.0e-3, "ch": 1.5, "shifting": "skillen", "belt": {"speed": 0.05}})
+    assert fast.numerics.shifting.min_speed == pytest.approx(0.5 * 0.05)
+    lind = build_scene(case_from_dict({"dp": 4.0e-3, "ch": 1.5, "shifting": "lind"}))
     assert lind.numerics.shifting.near_surface == "tangential"
-    skillen = build_scene(paper(shifting="skillen", shift_near_surface="tangential", dp=4.0e-3))
-    assert skillen.numerics.shifting.near_surface == "none"
     assert build_scene(paper(shifting="lind", dp=4.0e-3)).numerics.shifting.near_surface == "none"
-    with pytest.raises(SceneError, match="case.shift_near_surface: 'normal' is not one of none, tangential"):
-        build_scene(paper(shifting="skillen", shift_near_surface="normal", dp=4.0e-3))
+    with pytest.raises(SceneError, match="numerics.shifting.near_surface: 'normal' is not one of none, tangential"):
+        build_scene(paper(shifting="skillen", numerics={"shifting": {"near_surface": "normal"}}, dp=4.0e-3))
 
 
 @pytest.mark.slow
@@ -282,7 +301,7 @@ def test_checkpoint_key_covers_case_solver_and_threads(monkeypatch):
     key = front.checkpoint_key(case, 2)
     assert key == front.checkpoint_key(case_from_dict(d), 2)
     assert key != front.checkpoint_key(case, 1)
-    assert key != front.checkpoint_key(case_from_dict({**d, "cfl": 0.25}), 2)
+    assert key != front.checkpoint_key(case_from_dict({**d, "numerics": {"cfl": 0.25}}), 2)
     monkeypatch.setattr(front, "source_hash", lambda: "another solver")
     assert key != front.checkpoint_key(case, 2)
 
@@ -311,8 +330,6 @@ def test_lubrication_start_velocity_is_the_film_profile_with_zero_flux(start):
 def test_start_velocity_is_validated():
     with pytest.raises(SceneError, match="case.start_velocity.*rest, lubrication"):
         paper(start_velocity="moving")
-    with pytest.raises(SceneError, match="case.start_velocity: a warm start"):
-        paper(start="warm", warm_from="x.nc", start_velocity="lubrication")
 
 
 @pytest.mark.slow
@@ -341,9 +358,9 @@ def test_a_resumed_run_takes_its_start_from_the_checkpoint(tmp_path, monkeypatch
 
 def test_no_tension_is_passed_to_the_scene():
     assert build_scene(coarse_conveyor_case()).numerics.no_tension is False
-    assert build_scene(coarse_conveyor_case(no_tension=True)).numerics.no_tension is True
-    with pytest.raises(SceneError, match="case.no_tension"):
-        coarse_conveyor_case(no_tension="yes")
+    assert build_scene(coarse_conveyor_case(numerics={"no_tension": True})).numerics.no_tension is True
+    with pytest.raises(SceneError, match="case.numerics.no_tension"):
+        coarse_conveyor_case(numerics={"no_tension": "yes"})
 
 
 @pytest.mark.slow
@@ -354,7 +371,8 @@ def test_no_tension_holds_the_upstream_contact_line_that_weak_diffusion_loses():
     With the fluid density floored at rho0 the largest deviation stays below 2.5 % through 2.6 s
     (1.85 % measured to 2.4 s)."""
     from solver.simulation import Simulation
-    case = coarse_conveyor_case(ch=1.8, density_diffusion=0.05, cfl=0.54, no_tension=True)
+    case = coarse_conveyor_case(ch=1.8, numerics={"density_diffusion": 0.05, "cfl": 0.54, "cfl_rule": "fixed",
+                                                  "no_tension": True})
     assert worst_density_deviation(Simulation(build_scene(case)), 2.6) < 0.025
 
 

@@ -6,11 +6,12 @@ import yaml
 from study import stability
 
 
-def run(status="completed", reason="", dev=0.02, pen=0.0, drift=0.01, ke=1e-3, cfl=0.2, dp=0.004, **case_keys):
+def run(status="completed", reason="", dev=0.02, pen=0.0, drift=0.01, ke=1e-3, cfl=0.2, dp=0.004, **numerics):
+    """A run whose case file (as the solver records it) has these numerics keys."""
     t = np.linspace(0.0, 1.0, 11)
-    case = {"cfl": cfl, "ch": 1.5, "shifting": "skillen", "max_area_drift": 0.05,
-            "coefsound": 10.0, "density_diffusion": 0.1, "boundary": "mdbc", "shifting_coefficient": None,
-            **case_keys}
+    case = {"ch": 1.5, "shifting": "skillen", "max_area_drift": 0.05, "coefsound": 10.0,
+            "numerics": {"cfl": cfl, "cfl_rule": "fixed", "density_diffusion": 0.1, "boundary": "mdbc",
+                         "shifting": {"method": "skillen", "coefficient": None}, **numerics}}
     return xr.Dataset(
         {"max_density_deviation": ("diag_time", np.linspace(0.0, dev, 11)),
          "max_penetration": ("diag_time", np.linspace(0.0, pen, 11)),

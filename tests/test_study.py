@@ -56,7 +56,7 @@ def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():
     with pytest.raises(cfgmod.ConfigError) as exc:
         cfgmod.validate(c)
     msg = str(exc.value)
-    assert "dp3mm_ch1_lind" in msg and "physics.shifting.method: lind needs ch >= 1.1" in msg
+    assert "dp3mm_ch1_lind" in msg and "numerics.shifting.method: lind needs ch >= 1.1" in msg
     assert "8 neighbours" in msg and "skillen or none" in msg
 
 
