@@ -1,6 +1,6 @@
 """How far the viscous time-step limit dt = C h^2 / nu can be stretched, by laminar-term update.
 
-Runs the periodic film of examples/film.yaml (the paper fluid on its 15.3 deg incline; SPEC
+Runs the periodic film of examples/film.yaml (the paper fluid on its 15.3 deg incline; docs/scheme.md
 section 7) at --dp and --ch, 18.76 mm deep rounded to whole rows, from rest with a fixed step
 dt = C h^2 / nu for each --c, to --end s (a few viscous times H^2 / nu = 0.087 s), and reports
 whether it stays bounded, the RMS error of u(z) against the exact semi-parabolic profile (over

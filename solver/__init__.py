@@ -1,4 +1,4 @@
-"""sph-surge solver: a compact 2D weakly-compressible SPH engine (SPEC section 6)."""
+"""sph-surge solver: a compact 2D weakly-compressible SPH engine (docs/scheme.md section 6)."""
 __version__ = "0.1.0"
 
 from .sources import use_keyed_numba_cache

@@ -1,5 +1,5 @@
 """The acoustic edge of C_CFL: the largest C at which the laminar term and the density diffusion
-still damp the step's acoustic pair (docs/numerics.md, "What sets the coarse edge").
+still damp the step's acoustic pair (docs/numerics.md).
 
 Linearised about fluid at rest on a square lattice (spacing dp, V = dp^2, rho = rho0), a plane
 wave exp(i k.x) sees the solver's pair sums (solver/forces.py) through their symbols, with

@@ -100,7 +100,7 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
     def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, h, rho0, dp2, n_lattice):
         """Set density and no-slip velocity of every active boundary particle from its ghost.
 
-        v_g is Shepard-interpolated (SPEC), or first-order corrected like the density when
+        v_g is Shepard-interpolated (the paper's), or first-order corrected like the density when
         ``corrected_velocity`` (and the matrix is well conditioned).
         """
         alpha = alpha_2d(h)

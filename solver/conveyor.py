@@ -1,4 +1,4 @@
-"""The conveyor-belt flow-front case (SPEC sections 1-2): physical numbers -> Scene + probes.
+"""The conveyor-belt flow-front case (docs/scheme.md sections 1-2): physical numbers -> Scene + probes.
 
 Lab frame, x downslope along the belt, z bed-normal, gravity g (sin theta, -cos theta).
 The belt is the bottom wall z < 0, fixed particles carrying the velocity -u_b (upslope),
@@ -53,7 +53,7 @@ class Steady:
     max_time: float = 30.0  # s: give up (status not_steady) after this
     min_time: float = 4.0  # s after the end of the belt ramp before steadiness counts: the start's
     # transient, which the detection's signals do not see (measured to end by 3-3.5 s at dp = 0.5
-    # and 1 mm and by 5-6 s at dp = 1.5-2.25 mm: docs/conveyor.md, "The start's transient and min_time")
+    # and 1 mm and by 5-6 s at dp = 1.5-2.25 mm: docs/conveyor.md)
     stop: bool = True  # false: run to max_time and average its final window (fixed end time)
 
 
@@ -333,7 +333,7 @@ def front_surface(c: ConveyorCase) -> list[list[float]]:
 
 
 def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dict:
-    """The generic scene of SPEC section 2 as plain data. ``warm`` (a ``warm.WarmState``)
+    """The generic scene of docs/scheme.md section 2 as plain data. ``warm`` (a ``warm.WarmState``)
     gives the free surface of a warm start; without it a warm case is built with the
     lubrication shape (for validation before the run it starts from exists). The lubrication
     start is the steady front of ``scheme_fluid(c, flux_ratio)``, its rows filling that
@@ -397,7 +397,7 @@ def lubrication_velocity(c: ConveyorCase, scene: Scene, x: np.ndarray, z: np.nda
     """Lab-frame (u, w) of the steady film at fluid points, w = 0: at the local depth h of
     the initial surface and under a bed moving upslope at U (the belt, or its taper near the
     upstream wall), u = u_rel(z) - U with u_rel the film relative to the bed whose flux is
-    U h. Newtonian: u_rel = U 3 (s - s^2/2), s = z / h (SPEC section 5). Herschel-Bulkley:
+    U h. Newtonian: u_rel = U 3 (s - s^2/2), s = z / h (docs/scheme.md section 5). Herschel-Bulkley:
     u_rel = ``HBFluid.film`` at the driving slope S(h) of q(h, S) = U h. The depth-mean lab
     velocity is then zero: no net flux."""
     if scene.fluid.profiles:

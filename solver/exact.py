@@ -1,4 +1,4 @@
-"""Exact solutions of SPEC section 7, for validation."""
+"""Exact solutions of docs/scheme.md section 7, for validation."""
 from __future__ import annotations
 
 import numpy as np

@@ -2,7 +2,7 @@
 
 The conveyor's body settles where its film, relative to the belt, carries u_b h (zero flux
 in the lab frame). An SPH film carries a flux q_SPH(h) a little off the exact q(h)
-(g sin(theta) h^3 / (3 nu), SPEC section 7, or the Herschel-Bulkley film's), so the scheme's
+(g sin(theta) h^3 / (3 nu), docs/scheme.md section 7, or the Herschel-Bulkley film's), so the scheme's
 body settles off h_n, and a start filled to h_n drains or fills its body through the front
 for seconds.
 

@@ -2,7 +2,7 @@
 
 In the belt frame a uniform film of local depth h on slope theta has
   u*(z*) = 3 (nu / nu_eff) (h* z* - z*^2 / 2) + s,   u* = u / u_b,  z* = z / h_n,
-with h_n^2 = 3 nu u_b / (g sin theta) (SPEC section 5) and s the slip of the fluid on the bed
+with h_n^2 = 3 nu u_b / (g sin theta) (docs/scheme.md section 5) and s the slip of the fluid on the bed
 (0 for no slip). A least-squares quadratic u* = c0 + c1 z* + c2 z*^2 gives
   nu_eff / nu = -3 / (2 c2),   s = c0,
 from the curvature alone, whatever the depth: a surface slope adds a pressure gradient that

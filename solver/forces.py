@@ -176,7 +176,7 @@ class PairConstants(NamedTuple):
     av: float  # alpha h c0 of the artificial viscosity (0: off)
 
 
-# ---- the SPEC terms of one pair (a, b), gradW_ab = F r_ab, each inlined into the loop ----
+# ---- the paper's terms of one pair (a, b), gradW_ab = F r_ab, each inlined into the loop ----
 
 @nb.njit(inline="always", cache=True)
 def two_reciprocals(x, y):
@@ -215,7 +215,7 @@ def pair_viscosity(nu_a, nu_b, fluid_wall, a_is_fluid):
     """nu_ab: the geometric mean sqrt(nu_a nu_b) of two fluid particles; for a fluid-wall pair
     the fluid particle's own. Across a yield surface the two differ by up to mu_max / mu; the
     harmonic mean lets the plug edge shear too much, the arithmetic one too little
-    (docs/numerics.md, "Herschel-Bulkley")."""
+    (docs/numerics.md)."""
     if fluid_wall:
         return nu_a if a_is_fluid else nu_b
     return math.sqrt(nu_a * nu_b)
@@ -251,7 +251,7 @@ def diffusion_weight(delta, hc0, rdotg, inv_r2e):
 
 @nb.njit(inline="always", cache=True)
 def diffusion_spec(g, drab, dz, rho0, k_hyd):
-    """(a's, b's) terms g ((rho_a - rho_b) - rho^H_ab), per V_b and V_a, with SPEC's
+    """(a's, b's) terms g ((rho_a - rho_b) - rho^H_ab), per V_b and V_a, with the paper's
     rho^H_ab = rho0 ((1 + k_hyd (z_a - z_b))^(1/7) - 1), k_hyd = rho0 g_z / B."""
     fa, fb = hydrostatic_pair(k_hyd * dz)
     return g * (drab - rho0 * fa), g * (-drab - rho0 * fb)

@@ -1,4 +1,4 @@
-"""Lubrication (long-wave) theory of a steady viscous front on a belt (SPEC sections 1, 5).
+"""Lubrication (long-wave) theory of a steady viscous front on a belt (docs/scheme.md sections 1, 5).
 
 Belt frame, xi = distance upslope from the toe, eta = h / h_n:
   dh/dxi = tan(theta) (h_n^2 - h^2) / h^2   =>   xi tan(theta) / h_n = atanh(eta) - eta

@@ -3,7 +3,7 @@
 Continuity density has no restoring force towards a particle spacing, only towards a change
 of it: fluid whose particles stand further apart than their volumes m/rho say keeps its
 density and with it its pressure, and the room it takes without mass stays (the conveyor
-front's inflation, docs/numerics.md, "Where the volume goes"). With the kernel concentration
+front's inflation, docs/numerics.md). With the kernel concentration
 
     C_a = sum_b (m_b / rho_b) W_ab   (fluid and wall particles, a itself included)
 

@@ -14,7 +14,7 @@ import numpy as np
 import yaml
 
 SHIFTING_METHODS = ("none", "skillen", "lind")
-# lind within 2h of the free surface: SPEC's no shift, or the shift along the surface only
+# lind within 2h of the free surface: the paper's no shift, or the shift along the surface only
 NEAR_SURFACE = ("none", "tangential")
 BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")

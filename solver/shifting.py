@@ -4,8 +4,8 @@ skillen: dr = -A h |u_a| dt gradC, zero where div r < thr, scaled by (div r - th
          up to div r = 2, each component clipped to MAX_SHIFT dp. With ``min_speed`` > 0 the
          speed is max(|u_a|, min_speed) where no wall particle is within 2h: |u_a| depends on
          the frame, and where the lab-frame velocity passes through zero inside a sheared layer
-         SPEC's shift vanishes while the shear keeps disordering the particles. Within reach of
-         a wall SPEC's |u_a| stays: slow fluid there is a stagnant corner (a free surface
+         the paper's shift vanishes while the shear keeps disordering the particles. Within reach of
+         a wall the paper's |u_a| stays: slow fluid there is a stagnant corner (a free surface
          against a wall), which a floored shift pulls apart (docs/numerics.md, "Skillen's speed
          floor").
 lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to MAX_SHIFT dp; no shift for
@@ -15,7 +15,7 @@ lind:    dr = -D gradC, D = A_L h^2 / 2, each component clipped to MAX_SHIFT dp;
          only: dr = -D (gradC - (gradC.n) n), n the weighted mean of the outward normals
          -gradC/|gradC| of the free-surface particles within 2h (``surface_normals``), except
          the free-surface particles within 2h of a wall (where the surface meets a wall: no
-         shift, as SPEC).
+         shift, as the paper).
 Density correction (default on): shifting moves particles relative to the fluid, so each
 particle's volume changes by V div(dr); with its mass fixed its density becomes
 rho (1 - div(dr)), div(dr)_a = sum_b V_b (dr_b - dr_a).gradW_ab, summed in the next
@@ -225,7 +225,7 @@ def lind_shift_tangential(kind, gcx, gcz, near, surface, snx, snz, wnx, wnz, s0,
     """dr = -D gradC, each component clipped, never into a wall; within 2h of the free surface
     (``near``) only its part along the surface, -D (gradC - (gradC.n) n), n = (snx, snz)
     (``surface_normals``); no shift where n is zero, nor for a free-surface particle (``surface``)
-    with a wall particle within 2h (where the surface meets a wall, as SPEC's lind)."""
+    with a wall particle within 2h (where the surface meets a wall, as the paper's lind)."""
     for i in nb.prange(n_active):
         dx_out[i] = 0.0
         dz_out[i] = 0.0

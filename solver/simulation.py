@@ -43,7 +43,7 @@ class StepInfo:
 
 
 class Simulation:
-    """Owns the particle arrays and advances them by SPEC section 6."""
+    """Owns the particle arrays and advances them by docs/scheme.md section 6."""
 
     def __init__(self, scene: Scene, particles: Particles | None = None):
         self.scene = scene

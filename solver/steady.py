@@ -126,7 +126,7 @@ def _line_fits(t, ys, first):
     return slope, se
 
 
-FRONT_VELOCITY_SPAN = 1.0  # s: zeta_f's toe velocity is averaged over one second (SPEC section 4)
+FRONT_VELOCITY_SPAN = 1.0  # s: zeta_f's toe velocity is averaged over one second (docs/scheme.md section 4)
 
 
 def front_velocity_fit(t, toe) -> tuple[float, float]:

@@ -1,4 +1,4 @@
-"""Lubrication theory of a Herschel-Bulkley front on a belt (generalising SPEC section 5).
+"""Lubrication theory of a Herschel-Bulkley front on a belt (generalising docs/scheme.md section 5).
 
 A film of depth h on a bed at rest, driven by g S along the bed (S: the effective slope),
 is yielded below h0 = h - tau_y / (rho g S) and carries a plug above it:

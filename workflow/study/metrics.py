@@ -1,4 +1,4 @@
-"""Error metrics of SPEC section 4 (paper eqs. 14-17), pure functions over xarray objects.
+"""Error metrics of docs/scheme.md section 4 (paper eqs. 14-17), pure functions over xarray objects.
 
 x* is measured upslope from the toe in units of the computed normal depth h_n, depths
 are h/h_n, velocities u* = (u + u_b)/u_b in the belt frame; all from the steady-window
@@ -15,7 +15,7 @@ within that of the depth at both its ends. On a depth that does not drift, the f
 own noise makes zeta_h's se larger than the window mean's, by a factor of 1.7 on average for
 white noise (tests/test_study.py): conservative.
 
-Beyond SPEC, a diagnostic beside zeta_f: zeta_f_body, the same error of the equivalent front
+beyond the paper, a diagnostic beside zeta_f: zeta_f_body, the same error of the equivalent front
 (``front_body_velocity_error``), which tells a front that moves from a toe that wanders.
 """
 from __future__ import annotations
@@ -45,8 +45,7 @@ def last_second_velocity(t, position, u_b: float) -> tuple[float, float]:
 def zeta_f_error(t, toe, u_b: float) -> float:
     """Standard error of zeta_f from the toe's own scatter (``last_second_velocity``). A wander
     of the toe slower than the second shows as slope, not scatter: at dp <= 1 mm the one-second
-    velocities of a settled front scatter by up to 1.6 times this se (docs/conveyor.md, "The
-    toe's wander")."""
+    velocities of a settled front scatter by up to 1.6 times this se (docs/conveyor.md)."""
     return last_second_velocity(t, toe, u_b)[1]
 
 
@@ -206,7 +205,7 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         "zeta_f": "front velocity error |u*_f - u*_b| / u*_b",
         "zeta_f_se": "standard error of zeta_f from the toe's scatter over its second",
         "zeta_f_body": "front velocity error of the front's body: |u_e| / u_b, u_e the equivalent "
-                       "front's velocity over zeta_f's second (not SPEC's metric; a diagnostic)",
+                       "front's velocity over zeta_f's second (not the paper's metric; a diagnostic)",
         "zeta_f_body_se": "standard error of zeta_f_body from the equivalent front's scatter over its second",
         "zeta_h": "uniform depth error against the computed h_n",
         "zeta_h_paper": "uniform depth error against the paper's normalising depth",

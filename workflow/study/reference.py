@@ -1,4 +1,4 @@
-"""Reference solution (SPEC section 5): lubrication theory, and optional measured CSV data."""
+"""Reference solution (docs/scheme.md section 5): lubrication theory, and optional measured CSV data."""
 from __future__ import annotations
 
 import math
@@ -26,7 +26,7 @@ def theory(x_star: np.ndarray, stations, z_star: np.ndarray, slope_deg: float) -
          "station_depth": ("station", eta_st, {"units": "1", "long_name": "theory depth h/h_n at the station"}),
          "velocity": (("station", "z_star"), u, {"units": "1", "long_name": "theory u* (belt frame)"})},
         coords={"x_star": np.asarray(x_star, dtype=float), "station": st, "z_star": zs},
-        attrs={"source": "lubrication theory (SPEC section 5)"})
+        attrs={"source": "lubrication theory (docs/scheme.md section 5)"})
 
 
 def theory_for_case(case, x_star, stations, z_star) -> xr.Dataset:

@@ -278,7 +278,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     wall = np.nansum(ds["case_wall_time"].values)
     summary = (f"<p>{n} cases: " + ", ".join(f"{v} {html.escape(k)}" for k, v in counts.items())
                + f". Total simulation wall time {wall:.0f} s.</p>"
-               + "<p>Metrics (SPEC section 4) are computed against lubrication theory over the "
+               + "<p>Metrics (docs/scheme.md section 4) are computed against lubrication theory over the "
                "steady averaging window of each run. A run that did not reach steady state by its "
                "maximum time is shown with its metrics over its final window, marked "
                "<b>steady: no</b> (hollow markers in the figures): indicative only. Diverged runs "
@@ -296,7 +296,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "runs' combined se, and no "
                "verdict changed (docs/conveyor.md, \"Round-off realisations\"). The campaign key "
                "ensemble runs each grid case in several realisations and puts their spread into the se. "
-               "The case table's zeta_f of the front's body, beyond SPEC, is the same error of the "
+               "The case table's zeta_f of the front's body, beyond the paper, is the same error of the "
                "equivalent front (the fluid area downstream of a lab-fixed point over h_n) over the same "
                "second: where zeta_f reads more than it, the toe wandered or particles joined or left the "
                "tip while the front itself held (docs/conveyor.md, \"The toe's wander\").</p>"

@@ -2,7 +2,7 @@
 lubrication theory, against the parabola on the run's own local depth, and the theory's own
 second-order long-wave correction.
 
-SPEC section 5's reference at station x* (measured upslope from the toe) is the parabola
+docs/scheme.md section 5's reference at station x* (measured upslope from the toe) is the parabola
 u* = 3 (z/h - z^2 / (2 h^2)) on the theory's depth h(x*). For each run and station this prints
 
 - the run's mean depth at the station (its ``mean_surface_elevation``) against the theory's, and
