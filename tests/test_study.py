@@ -581,3 +581,43 @@ def test_the_ensemble_mean_and_its_error():
     v, se = ensemble_mean(np.array([[1.0, 2.0], [3.0, np.nan]]))  # per station, no window errors
     assert v.tolist() == [2.0, 2.0] and se[0] == pytest.approx(1.0) and np.isnan(se[1])
     assert all(np.isnan(ensemble_mean(np.array([np.nan, np.nan]))))
+
+
+def test_each_run_is_scored_against_the_theory_of_its_own_physical_case(tmp_path):
+    """A campaign whose extra case runs at 10 deg beside the grid's 15.3 deg: each run, built here
+    as its own case's lubrication front, scores zero against the theory of the case it recorded
+    (``study metrics``), and the campaign says that its cases differ in physics."""
+    from solver.conveyor import case_from_dict
+    from study.cli import main as study_main
+    from study.reference import physics_of, recorded_case
+    cfg_path = tmp_path / "campaign.yaml"
+    cfg_path.write_text(yaml.safe_dump({
+        "case": {"scheme": "spec"}, "grid": {"dp": [3e-3], "ch": [1.5], "shifting": ["skillen"]},
+        "extra_cases": [{"dp": 3e-3, "ch": 1.5, "shifting": "skillen", "tag": "slope10",
+                         "overrides": {"slope_deg": 10.0}}]}))
+    cfg = cfgmod.load(cfg_path)
+    x = np.round(np.arange(0, 14.0001, 0.1), 10)
+    z = np.round(np.arange(0, 1.3001, 0.025), 10)
+    st = np.array([0.76, 1.5, 9.7])
+    scores = {}
+    for c in cfgmod.cases(cfg):
+        case = case_from_dict(cfgmod.case_dict(cfg, c))
+        ref = theory(x, st, z, case.slope_deg)
+        run = xr.Dataset(
+            {"mean_surface_elevation": ("x_star", ref["surface"].values * case.h_n),
+             "mean_uniform_depth": ((), case.h_n), "front_velocity": ((), 0.0),
+             "mean_velocity_star": (("station", "z_star"), ref["velocity"].values)},
+            coords={"x_star": x, "station": st, "z_star": z},
+            attrs={"status": "completed", "h_n_m": case.h_n, "belt_speed_m_s": case.belt.speed,
+                   "normalising_depth_m": 0.0186, "case_yaml": case.to_yaml()})
+        assert recorded_case(run).slope_deg == case.slope_deg
+        run.to_netcdf(tmp_path / f"{c.id}.nc")
+        assert study_main(["metrics", str(cfg_path), str(tmp_path / f"{c.id}.nc"),
+                           "-o", str(tmp_path / f"{c.id}_m.nc")]) in (0, None)
+        with xr.open_dataset(tmp_path / f"{c.id}_m.nc") as m:
+            scores[c.id] = (float(m.zeta_fs), float(np.nanmax(m.zeta_u.values)), float(m.zeta_h))
+    assert set(scores) == {"dp3mm_ch1.5_skillen", "dp3mm_ch1.5_skillen_slope10"}
+    for zeta_fs, zeta_u, zeta_h in scores.values():
+        assert zeta_fs < 1e-12 and zeta_u < 1e-12 and zeta_h < 1e-12
+    a, b = (physics_of(case_from_dict(cfgmod.case_dict(cfg, c))) for c in cfgmod.cases(cfg))
+    assert a != b and {k for k in a if a[k] != b[k]} == {"slope_deg"}

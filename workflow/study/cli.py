@@ -30,14 +30,15 @@ def cmd_case_file(a):
     _write_text(a.output, yaml.safe_dump(case_dict(cfg, match[0]), sort_keys=False))
 
 
-def _reference(cfg):
+def _reference(cfg, case):
+    """The reference of one run: the theory of ``case`` (the physical case the run recorded) and
+    the campaign's measured profiles, if any."""
     import numpy as np
-    from .config import solver_case
     from .reference import read_surface_csv, read_velocity_csv, theory_for_case
     lo, hi = cfg["metrics"]["free_surface_x_star"]
     x = np.round(np.arange(lo, hi + 1e-9, 0.1), 10)
     z = np.round(np.arange(0.0, 1.3 + 1e-9, 0.025), 10)
-    ref = theory_for_case(solver_case(cfg), x, cfg["metrics"]["stations"], z)
+    ref = theory_for_case(case, x, cfg["metrics"]["stations"], z)
     m = cfg["reference"]["measured"]
     measured = {"surface": read_surface_csv(m["free_surface"]) if m.get("free_surface") else None,
                 "velocity": {float(k): read_velocity_csv(v) for k, v in (m.get("velocity") or {}).items()}}
@@ -48,10 +49,14 @@ def cmd_metrics(a):
     import xarray as xr
     from solver.output import write_atomic
     from .metrics import case_metrics
+    from .config import solver_case
+    from .reference import recorded_case
     cfg = _cfg(a.config)
-    ref, measured = _reference(cfg)
     with xr.open_dataset(a.run) as run:
-        m = case_metrics(run.load(), ref, tuple(cfg["metrics"]["free_surface_x_star"]), measured)
+        run = run.load()
+    case = recorded_case(run) or solver_case(cfg)  # each run against its own physics
+    ref, measured = _reference(cfg, case)
+    m = case_metrics(run, ref, tuple(cfg["metrics"]["free_surface_x_star"]), measured)
     m.attrs["case"] = Path(a.run).parent.name
     write_atomic(m, a.output)
 
@@ -71,6 +76,13 @@ def cmd_reduce(a):
             metrics.append(m.load())
     ds = build(cs, runs, metrics)
     import yaml
+    from .reference import physics_of, recorded_case
+    physics = [physics_of(recorded_case(r) or solver_case(cfg, c)) for r, c in zip(runs, cs)]
+    mixed = [c.id for c, p in zip(cs, physics) if p != physics[0]]
+    if mixed:  # each run was scored against its own theory; one h_n or slope would misstate them
+        ds.attrs["physics_differ"] = (f"{', '.join(mixed)} differ in physics from {cs[0].id}: each run's "
+                                      "metrics are against its own theory, but the figures' theory "
+                                      "curves and the campaign's h_n and slope are the first case's")
     ds.attrs.update(h_n_m=float(runs[0].attrs.get("h_n_m", float("nan"))),
                     normalising_depth_m=float(cfg["reference"]["normalising_depth"]),
                     slope_deg=float(solver_case(cfg).slope_deg),

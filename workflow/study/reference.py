@@ -29,6 +29,25 @@ def theory(x_star: np.ndarray, stations, z_star: np.ndarray, slope_deg: float) -
         attrs={"source": "lubrication theory (docs/scheme.md section 5)"})
 
 
+# the case keys that set the physics a reference depends on (the rest are numerics and probes)
+PHYSICAL_KEYS = ("density", "viscosity", "rheology", "yield_stress", "consistency", "index", "slope_deg",
+                 "gravity", "belt", "normalising_depth")
+
+
+def recorded_case(run: xr.Dataset):
+    """The solver case a run recorded (its ``case_yaml``), or None for a run without one."""
+    import yaml
+    from solver.conveyor import case_from_dict
+    text = run.attrs.get("case_yaml")
+    return case_from_dict(yaml.safe_load(text)) if text else None
+
+
+def physics_of(case) -> dict:
+    """The physical keys of a solver case (``PHYSICAL_KEYS``), as plain data."""
+    d = case.to_dict()
+    return {k: d[k] for k in PHYSICAL_KEYS}
+
+
 def theory_for_case(case, x_star, stations, z_star) -> xr.Dataset:
     """``theory`` for a solver case (solver.conveyor.ConveyorCase) of either rheology. For a
     Herschel-Bulkley fluid: the front of ``solver.viscoplastic.front_profile`` and, at each

@@ -276,8 +276,10 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     statuses = [str(s) for s in ds["case_status"].values]
     counts = {s: statuses.count(s) for s in sorted(set(statuses))}
     wall = np.nansum(ds["case_wall_time"].values)
+    mixed = ds.attrs.get("physics_differ")
     summary = (f"<p>{n} cases: " + ", ".join(f"{v} {html.escape(k)}" for k, v in counts.items())
                + f". Total simulation wall time {wall:.0f} s.</p>"
+               + (f"<p><b>Cases of different physics.</b> {html.escape(mixed)}.</p>" if mixed else "")
                + "<p>Metrics (docs/scheme.md section 4) are computed against lubrication theory over the "
                "steady averaging window of each run. A run that did not reach steady state by its "
                "maximum time is shown with its metrics over its final window, marked "
