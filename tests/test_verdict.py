@@ -268,3 +268,23 @@ def test_with_an_ensemble_the_cheapest_is_a_grid_point_by_its_ensemble_mean():
     i = np.flatnonzero(ok)[np.argmin(grid["wall_time"].values[ok])]
     assert row["cheapest"][0.05] == (str(grid["case_id"].values[i]), float(grid["wall_time"].values[i]),
                                      float(grid["zeta_h"].values[i]), pytest.approx(2e-4))
+
+
+def test_zeta_u_is_below_5_percent_only_if_every_ch_is_below_by_more_than_2_se():
+    """The paper-like campaign with one Ch's toe station at 6.2 % at the finest dp: above 5 % by
+    more than 2 se (se 0.1 %), that Ch is not below, and the claim reads "not reproduced" although
+    the other Ch are below (a majority rule would call it reproduced). With every value below
+    5 % by more than 2 se the claim is reproduced; with se 0.5 % (the toe's 4.2 % + 2 se above
+    5 %) it is not."""
+    ds = campaign(paper_like)
+    ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], 0.005)
+    assert by_claim(ds)["zeta_u"].verdict == "not reproduced"
+    ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], 0.001)
+    assert by_claim(ds)["zeta_u"].verdict == "reproduced"
+    sh = str(ds["shifting"].values[0])
+    finest, ch = float(ds["dp"].min()), float(ds["ch"].values[0])
+    ds["zeta_u"].loc[dict(dp=finest, ch=ch, shifting=sh, station=0.76)] = 0.062
+    v = by_claim(ds)["zeta_u"]
+    assert v.verdict == "not reproduced"
+    n = ds.sizes["ch"]
+    assert f"Below 5 % by more than 2 se: {n - 1} of {n} Ch" in v.evidence

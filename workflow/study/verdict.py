@@ -333,8 +333,11 @@ def marginal_shifting_claim(ds, claim):
 
 
 def velocity_claim(ds, claim):
-    """zeta_u below 5 % at the finest dp at every station, and largest at the station nearest
-    the toe, for most Ch of the main method."""
+    """zeta_u below 5 % at every station and largest at the station nearest the toe, for every
+    Ch of the main method at its finest dp (where every station has a value), by the rules of
+    the other claims: below only by more than 2 se, and a station larger than the toe's only by
+    more than 2 se of the two. Contradicted when, in every Ch, the toe's station is below every
+    other by more than 2 se."""
     sh = main_method(ds)
     st = ds["station"].values
     toe = int(np.argmin(st))
@@ -345,22 +348,27 @@ def velocity_claim(ds, claim):
             continue
         dp = max(dps)  # the finest dp where every station has a value
         u = np.array([_value(ds, "zeta_u", dp, ch, sh, x) for x in st])
+        se = np.array([_se(ds, "zeta_u", dp, ch, sh, x) for x in st])
         n += 1
-        below += bool(np.all(u < 0.05))
-        toe_largest += bool(u[toe] >= u.max())
-        toe_smallest += bool(u.size > 1 and u[toe] < np.delete(u, toe).min())
+        below += bool(np.all(u + 2.0 * se < 0.05))  # an unknown se (NaN) never counts as below
+        others = np.delete(np.arange(u.size), toe)
+        gap = 2.0 * np.hypot(se[toe], se[others])
+        toe_largest += bool(np.all(u[others] - u[toe] <= gap))
+        toe_smallest += bool(others.size and np.all(u[others] - u[toe] > gap))
         sels.append(dict(dp=dp, ch=float(ch), shifting=sh))
-        parts.append(f"Ch {ch:g} at {_mm(dp)}: " + ", ".join(f"{v:.3f}" for v in u))
+        parts.append(f"Ch {ch:g} at {_mm(dp)}: " + ", ".join(
+            f"{v:.3f}" + (f" ± {2 * e:.3f}" if np.isfinite(e) and e > 0 else "") for v, e in zip(u, se)))
     if n == 0:
         return Verdict(claim, "no data", "no finished run", [], [])
-    if below > n / 2 and toe_largest > n / 2:
+    if below == n and toe_largest == n:
         verdict = "reproduced"
-    elif toe_smallest > n / 2:
+    elif toe_smallest == n:
         verdict = "contradicted"
     else:
         verdict = "not reproduced"
-    evidence = (f"{sh}, zeta_u at x* = " + ", ".join(f"{x:g}" for x in st) + ": " + "; ".join(parts)
-                + f". All below 5 %: {below} of {n} Ch; largest at x* = {st[toe]:g}: {toe_largest} of {n}")
+    evidence = (f"{sh}, zeta_u (± 2 se) at x* = " + ", ".join(f"{x:g}" for x in st) + ": " + "; ".join(parts)
+                + f". Below 5 % by more than 2 se: {below} of {n} Ch; largest at x* = {st[toe]:g} "
+                f"(no other station above it by more than 2 se): {toe_largest} of {n}")
     return Verdict(claim, verdict, evidence, *_status_note(ds, sels))
 
 
