@@ -129,3 +129,20 @@ def test_an_ensemble_of_different_sizes_names_its_grid_points_by_count():
     assert "grid points ran in 4 realisations: " + ", ".join(four) + "; in 1 realisation: " + ", ".join(rest) in text
     ds["realisations"][:] = 1
     assert "Ensemble:" not in render(ds, [], "grid: {}")
+
+
+def test_the_verdict_section_says_what_the_runs_start_from_and_which_scheme_they_run():
+    from solver.conveyor import case_from_dict
+    from study.reference import start_description
+    from study.report import verdict_table
+    ds = campaign(paper_like)
+    case = case_from_dict({"dp": 1e-3, "ch": 1.8, "shifting": "lind"})
+    ds.attrs.update(schemes=case.scheme, starts=start_description(case))
+    text = verdict_table(ds)
+    assert ("The runs start from the steady lubrication front at the scheme's own film depth, moving "
+            "with the film's velocity profile, the belt at full speed; their scheme, surge, departs") in text
+    assert 'href="../docs/numerics.md"' in text
+    paper = case_from_dict({"dp": 1e-3, "scheme": "spec", "start": "block"})
+    ds.attrs.update(schemes="spec", starts=start_description(paper))
+    assert "a block at rest at the normal depth, the belt ramped up from rest; their scheme, spec, is the paper's" \
+        in verdict_table(ds)

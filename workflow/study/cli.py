@@ -76,8 +76,11 @@ def cmd_reduce(a):
             metrics.append(m.load())
     ds = build(cs, runs, metrics)
     import yaml
-    from .reference import physics_of, recorded_case
-    physics = [physics_of(recorded_case(r) or solver_case(cfg, c)) for r, c in zip(runs, cs)]
+    from .reference import physics_of, recorded_case, start_description
+    recorded = [recorded_case(r) or solver_case(cfg, c) for r, c in zip(runs, cs)]
+    physics = [physics_of(case) for case in recorded]
+    ds.attrs["schemes"] = ", ".join(sorted({case.scheme for case in recorded}))
+    ds.attrs["starts"] = "; ".join(sorted({start_description(case) for case in recorded}))
     mixed = [c.id for c, p in zip(cs, physics) if p != physics[0]]
     if mixed:  # each run was scored against its own theory; one h_n or slope would misstate them
         ds.attrs["physics_differ"] = (f"{', '.join(mixed)} differ in physics from {cs[0].id}: each run's "

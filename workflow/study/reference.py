@@ -48,6 +48,17 @@ def physics_of(case) -> dict:
     return {k: d[k] for k in PHYSICAL_KEYS}
 
 
+def start_description(case) -> str:
+    """What a run starts from, in words."""
+    if case.start == "warm":
+        return "the final state of a coarser run (warm start)"
+    shape = ("a block at rest at the normal depth" if case.start == "block" else
+             "the steady lubrication front at the scheme's own film depth")
+    if case.start_velocity == "lubrication":
+        return shape.replace(" at rest", "") + ", moving with the film's velocity profile, the belt at full speed"
+    return shape + ", the belt ramped up from rest"
+
+
 def theory_for_case(case, x_star, stations, z_star) -> xr.Dataset:
     """``theory`` for a solver case (solver.conveyor.ConveyorCase) of either rheology. For a
     Herschel-Bulkley fluid: the front of ``solver.viscoplastic.front_profile`` and, at each

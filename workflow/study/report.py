@@ -134,7 +134,15 @@ def verdict_table(ds: xr.Dataset) -> str:
                     f'{"*" if v.unsteady else ""}</td>'
                     f'<td class="l">{html.escape(v.evidence)}{caveat}</td></tr>')
     finest = float(np.min(ds["dp"].values)) * 1000
-    return (f"<p>Each conclusion of the paper, judged on this campaign's own runs at its finest dp "
+    schemes = ds.attrs.get("schemes", "")
+    start = ""
+    if schemes:
+        departs = ("departs from the paper's (docs/scheme.md section 6) as "
+                   '<a href="../docs/numerics.md">docs/numerics.md</a> lists' if schemes != "spec"
+                   else "is the paper's as written (docs/scheme.md section 6)")
+        start = (f"<p>The runs start from {html.escape(ds.attrs.get('starts', ''))}; their scheme, "
+                 f"{html.escape(schemes)}, {departs}.</p>")
+    return (start + f"<p>Each conclusion of the paper, judged on this campaign's own runs at its finest dp "
             f"({finest:g} mm; the paper's finest is {PAPER_FINEST_DP * 1000:g} mm). "
             "<b>reproduced</b>: our numbers show it; <b>contradicted</b>: they show the opposite "
             "beyond their uncertainty (for a threshold: even the GCI extrapolation to dp &rarr; 0 "
