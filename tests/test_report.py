@@ -1,5 +1,7 @@
 """The HTML report from a synthetic campaign: the verdict on the first screen, and the page
 as headless Chromium renders it (images decoded, nothing fetched from outside)."""
+import html
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -138,11 +140,11 @@ def test_the_verdict_section_says_what_the_runs_start_from_and_which_scheme_they
     ds = campaign(paper_like)
     case = case_from_dict({"dp": 1e-3, "ch": 1.8, "shifting": "lind"})
     ds.attrs.update(schemes=case.scheme, starts=start_description(case))
-    text = verdict_table(ds)
+    text = html.unescape(verdict_table(ds))
     assert ("The runs start from the steady lubrication front at the scheme's own film depth, moving "
             "with the film's velocity profile, the belt at full speed; their scheme, surge, departs") in text
     assert 'href="../docs/numerics.md"' in text
     paper = case_from_dict({"dp": 1e-3, "scheme": "spec", "start": "block"})
     ds.attrs.update(schemes="spec", starts=start_description(paper))
     assert "a block at rest at the normal depth, the belt ramped up from rest; their scheme, spec, is the paper's" \
-        in verdict_table(ds)
+        in html.unescape(verdict_table(ds))
