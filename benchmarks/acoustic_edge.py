@@ -1,7 +1,7 @@
 """The acoustic edge of C_CFL: the model (solver/acoustic_edge.py) against runs.
 
 Each line of --runs (default benchmarks/acoustic_edge_runs.txt) is a run's name and its
-overrides of --case (``dp2-ch2.5-c0.62 dp=0.002 ch=2.5 cfl=0.62``); a line named ``*`` holds
+overrides of --case (``dp2-ch2.5-c0.62 dp=0.002 ch=2.5 numerics.cfl=0.62``); a line named ``*`` holds
 overrides of every run, applied before the run's own, and --set some more. Each run goes to
 --to s with ``steady.stop=false`` (``python -m solver front``, one thread, --jobs at a time),
 and the table gives nu / (c0 h), the acoustic C the run used, the model's edge
