@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import lubrication, schemes, viscoplastic
-from .scene import (SHIFTING_METHODS, Numerics, Scene, SceneError, YamlData, _as_float, parse_into, refuse_moved_keys,
+from .scene import (SHIFTING_METHODS, Numerics, Scene, SceneError, YamlData, parse_into, refuse_moved_keys,
                     scene_from_dict)
 from .steady import SteadyCriteria
 
@@ -111,8 +111,8 @@ class ConveyorCase(YamlData):
 
     def __post_init__(self):
         if self.numerics is None:  # built in Python without numerics: the scheme's own
-            self.numerics = parse_into(Numerics, preset_numerics(self.scheme, self.belt.speed, self.newtonian),
-                                       "case.numerics")
+            self.numerics = Numerics()  # the physics first: the preset depends on h_n / dp
+            self.numerics = parse_into(Numerics, preset_numerics(self), "case.numerics")
         self.numerics.shifting.method = self.shifting  # the grid's axis, recorded with the rest
 
     @property
@@ -179,9 +179,9 @@ MOVED_CASE_KEYS = {
 }
 
 
-def preset_numerics(scheme: str, belt_speed: float, newtonian: bool = True) -> dict:
-    """The numerics block of scheme ``scheme`` (``schemes.preset``)."""
-    return schemes.preset(scheme, belt_speed, newtonian).get("numerics", {})
+def preset_numerics(case: "ConveyorCase") -> dict:
+    """The numerics block of the case's scheme (``schemes.preset``)."""
+    return schemes.preset(case.scheme, case.belt.speed, case.newtonian, case.h_n / case.dp).get("numerics", {})
 
 
 def resolve_scheme(data: dict) -> dict:
@@ -196,10 +196,12 @@ def resolve_scheme(data: dict) -> dict:
     if method is not None and method != data.get("shifting", ConveyorCase.shifting):
         raise SceneError(f"case.numerics.shifting.method: {method!r}, but the case's shifting key, which "
                          f"sets the method, is {data.get('shifting', ConveyorCase.shifting)!r}: set shifting only")
-    belt = data.get("belt") if isinstance(data.get("belt"), dict) else {}
-    speed = _as_float(belt.get("speed", Belt().speed), "case.belt.speed")
-    newtonian = data.get("rheology", ConveyorCase.rheology) == "newtonian"
-    return schemes.merge(schemes.preset(name, speed, newtonian), data)
+    # the physical case alone (the paper's numerics, which change nothing physical): the preset
+    # takes the belt speed, the rheology and h_n / dp from it
+    physical = parse_into(ConveyorCase, {**{k: v for k, v in data.items() if k != "numerics"},
+                                         "scheme": "spec"}, "case")
+    return schemes.merge(schemes.preset(name, physical.belt.speed, physical.newtonian,
+                                        physical.h_n / physical.dp), data)
 
 
 def case_from_dict(data) -> ConveyorCase:

@@ -2,8 +2,9 @@
 
 ``spec`` is the paper's scheme as docs/scheme.md section 6 writes it (the ``Numerics``
 defaults). ``surge`` is the shipped scheme and every case's default: the departures of
-docs/numerics.md that let the front settle (for a yield-stress fluid, the implicit laminar
-term at C = 0.4 with the volume relaxation). A case's own keys override its preset's.
+docs/numerics.md that let the front settle, at C_CFL 0.6 where h_n holds at least 15 particles
+and 0.4 below (for a yield-stress fluid, the implicit laminar term at C = 0.4 with the volume
+relaxation). A case's own keys override its preset's.
 """
 from __future__ import annotations
 
@@ -11,9 +12,13 @@ import copy
 
 DEFAULT_SCHEME = "surge"
 SKILLEN_MIN_SPEED = 0.5  # surge: Skillen's shifting speed at least this fraction of the belt speed
+# surge: C_CFL 0.6 where the normal depth holds at least this many particles (the paper's least
+# resolution), 0.4 on coarser grids, where 0.6 held but degraded the metrics (docs/numerics.md)
+RESOLVED_DEPTH = 15.0
+CFL, COARSE_CFL = 0.6, 0.4
 
 
-def _surge(belt_speed: float, newtonian: bool) -> dict:
+def _surge(belt_speed: float, newtonian: bool, particles_across: float) -> dict:
     if not newtonian:  # a yield-stress fluid: the viscosity cap would bind an explicit step
         return {
             "start_velocity": "lubrication",
@@ -27,7 +32,7 @@ def _surge(belt_speed: float, newtonian: bool) -> dict:
     return {
         "start_velocity": "lubrication",  # the steady film's profile, belt running from t = 0
         "numerics": {
-            "cfl": 0.6,
+            "cfl": CFL if particles_across >= RESOLVED_DEPTH else COARSE_CFL,
             "cfl_rule": "damping",
             "viscous_update": "substepped",
             "viscous_correction": True,
@@ -39,13 +44,14 @@ def _surge(belt_speed: float, newtonian: bool) -> dict:
     }
 
 
-SCHEMES = {"spec": lambda belt_speed, newtonian: {}, "surge": _surge}
+SCHEMES = {"spec": lambda belt_speed, newtonian, particles_across: {}, "surge": _surge}
 
 
-def preset(name: str, belt_speed: float, newtonian: bool = True) -> dict:
+def preset(name: str, belt_speed: float, newtonian: bool = True, particles_across: float = RESOLVED_DEPTH) -> dict:
     """The case keys that scheme ``name`` sets (nested like a case file), for a Newtonian or a
-    Herschel-Bulkley fluid; ``belt_speed`` [m/s] scales the speeds it gives in units of u_b."""
-    return SCHEMES[name](belt_speed, newtonian)
+    Herschel-Bulkley fluid; ``belt_speed`` [m/s] scales the speeds it gives in units of u_b, and
+    ``particles_across`` (h_n / dp) picks surge's C_CFL."""
+    return SCHEMES[name](belt_speed, newtonian, particles_across)
 
 
 def merge(base: dict, changes: dict) -> dict:

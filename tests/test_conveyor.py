@@ -404,3 +404,11 @@ def test_toe_profile_theory_keeps_the_stations_and_the_flux():
     assert np.abs(tp.second_order_profile(9.7)[1]).max() < 1e-4
     s, d = tp.inertial_profile(0.76, 0.35)
     assert d[0] == 0.0 and abs(np.trapezoid(d, s)) < 1e-9
+
+
+@pytest.mark.parametrize("dp, cfl", [(2.25e-3, 0.4), (1.5e-3, 0.4), (1.25e-3, 0.6), (1.0e-3, 0.6), (2.5e-4, 0.6)])
+def test_surge_takes_c_cfl_0_6_where_the_depth_holds_15_particles_and_0_4_below(dp, cfl):
+    """h_n = 18.76 mm: 8.3, 12.5, 15.0, 18.8 and 75 particles across it. A case's own cfl wins."""
+    case = case_from_dict({"dp": dp, "ch": 1.8, "shifting": "lind"})
+    assert (case.numerics.cfl, case.numerics.cfl_rule) == (cfl, "damping")
+    assert case_from_dict({"dp": dp, "ch": 1.8, "numerics": {"cfl": 0.5}}).numerics.cfl == 0.5
