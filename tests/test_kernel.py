@@ -1,4 +1,4 @@
-"""Wendland C2 kernel: normalisation and gradient (SPEC section 6)."""
+"""Wendland C2 kernel: normalisation and gradient (docs/scheme.md section 6)."""
 import numpy as np
 import pytest
 

@@ -108,7 +108,7 @@ def test_lubrication_start_velocity_of_a_yield_stress_fluid():
 
 
 def test_reference_for_a_yield_stress_fluid():
-    """The study's reference: Newtonian cases get SPEC section 5 unchanged; a HB case the
+    """The study's reference: Newtonian cases get docs/scheme.md section 5 unchanged; a HB case the
     film at each station's depth, with zero lab-frame flux (depth-mean belt-frame u* = 1)."""
     from solver.conveyor import case_from_dict
     from study.reference import theory, theory_for_case
