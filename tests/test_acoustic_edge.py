@@ -90,33 +90,19 @@ def test_edge_is_where_the_amplification_crosses_one():
     assert acoustic_edge.spectral_radius(m) == pytest.approx(1.1306, abs=1e-4)
 
 
-def test_the_leapfrog_is_neutral_up_to_a_2_and_damping_lowers_its_edge():
-    """Undamped, the leapfrog's radius is 1 up to a = omega dt = 2 and above 1 beyond; on the
-    lattice its undamped edge is 2 / max h|G|, and the fast example's damping lowers it."""
-    for a in (0.3, 1.0, 1.9):
-        assert acoustic_edge.spectral_radius(acoustic_edge.leapfrog_amplification(a, 0.0, 0.0)) == \
-            pytest.approx(1.0, abs=1e-9)
-    assert acoustic_edge.spectral_radius(acoustic_edge.leapfrog_amplification(2.1, 0.0, 0.0)) > 1.5
-    undamped = acoustic_edge.edge(1.8, 0.0, 0.0, acoustic_edge.leapfrog_amplification)
-    assert undamped == pytest.approx(2.0 / acoustic_edge.lattice_symbols(1.8)[0].max(), abs=1e-3)
-    damped = acoustic_edge.edge(1.8, 0.524, 0.1, acoustic_edge.leapfrog_amplification)
-    assert acoustic_edge.edge(1.8, 0.524, 0.1) < damped < undamped
-
-
 def test_rule_leaves_the_paper_case_and_lowers_the_coarse_one():
     """At dp = 1 mm, Ch = 1.8 (nu / (c0 h) = 0.52) the rule keeps C = 0.6 exactly, so the shipped
-    runs are unchanged; at dp = 2.25 mm, Ch = 2.2 (0.19) it gives 0.85 C*; ``fixed`` and the
-    leapfrog keep cfl; the time step takes it."""
-    fine = build_scene(coarse_conveyor_case(dp=1e-3, ch=1.8, cfl=0.6, cfl_rule="damping"))
+    runs are unchanged; at dp = 2.25 mm, Ch = 2.2 (0.19) it gives 0.85 C*; ``fixed`` keeps cfl;
+    the time step takes it."""
+    damping = {"numerics": {"cfl": 0.6, "cfl_rule": "damping"}}
+    fine = build_scene(coarse_conveyor_case(dp=1e-3, ch=1.8, **damping))
     assert fine.acoustic_damping_ratio == pytest.approx(0.524, abs=0.002)
     assert fine.cfl_acoustic == 0.6
-    coarse = build_scene(coarse_conveyor_case(cfl=0.6, cfl_rule="damping"))
+    coarse = build_scene(coarse_conveyor_case(**damping))
     assert coarse.acoustic_damping_ratio == pytest.approx(0.191, abs=0.002)
     expect = acoustic_edge.MARGIN * acoustic_edge.edge(2.2, coarse.acoustic_damping_ratio, 0.1)
     assert coarse.cfl_acoustic == pytest.approx(expect) and 0.4 < coarse.cfl_acoustic < 0.5
-    assert build_scene(coarse_conveyor_case(cfl=0.6)).cfl_acoustic == 0.6
-    assert build_scene(coarse_conveyor_case(cfl=0.6, cfl_rule="damping",
-                                            density_update="leapfrog")).cfl_acoustic == 0.6
+    assert build_scene(coarse_conveyor_case(numerics={"cfl": 0.6, "cfl_rule": "fixed"})).cfl_acoustic == 0.6
     sim = Simulation(coarse)
     sim.amax, sim.vmax = 0.0, 0.0
     sim._update_dt()
@@ -131,35 +117,36 @@ def test_rule_does_not_bind_on_the_shipped_grids(config):
     their runs are those measured without it."""
     cfg = cfgmod.load(ROOT / "config" / config)
     for case in cfgmod.cases(cfg):
-        d = cfgmod.case_dict(cfg, case)
-        assert d["cfl_rule"] == "damping", case.id
-        scene = build_scene(case_from_dict(d))
-        assert scene.cfl_acoustic == d["cfl"], case.id
+        numerics = case_from_dict(cfgmod.case_dict(cfg, case)).numerics  # the scheme's, resolved
+        assert numerics.cfl_rule == "damping", case.id
+        scene = build_scene(case_from_dict(cfgmod.case_dict(cfg, case)))
+        assert scene.cfl_acoustic == numerics.cfl, case.id
         bound = acoustic_edge.MARGIN * acoustic_edge.edge(scene.ch, scene.acoustic_damping_ratio,
                                                           scene.numerics.density_diffusion)
-        assert bound > d["cfl"], case.id
+        assert bound > numerics.cfl, case.id
 
 
 def test_rule_leaves_a_very_viscous_scene_its_cfl():
     """The Couette example (nu / (c0 h) = 26.7, explicit laminar term): the laminar term damps the
     acoustic modes strongly, and its own stability is the viscous limit's, so C stays cfl."""
-    scene = example_scene("couette", cfl_rule="damping")
-    assert scene.viscous_update_used == "explicit" and scene.acoustic_damping_ratio > 10
-    assert scene.cfl_acoustic == scene.cfl
+    scene = example_scene("couette", numerics={"cfl_rule": "damping"})
+    assert scene.numerics.viscous_update == "explicit" and not scene.implicit_viscosity
+    assert scene.acoustic_damping_ratio > 10
+    assert scene.cfl_acoustic == scene.numerics.cfl
 
 
 def test_rule_refuses_what_it_cannot_bound():
-    with pytest.raises(SceneError, match="case.cfl_rule: 'auto' is not one of fixed, damping"):
-        coarse_conveyor_case(cfl_rule="auto")
-    with pytest.raises(SceneError, match="cfl_rule: 'auto' is not one of fixed, damping"):
-        example_scene("couette", cfl_rule="auto")
-    with pytest.raises(SceneError, match="density_update: leapfrog"):  # no damping at all
-        example_scene("couette", cfl_rule="damping", numerics={"density_diffusion": None},
+    with pytest.raises(SceneError, match="numerics.cfl_rule: 'auto' is not one of fixed, damping"):
+        coarse_conveyor_case(numerics={"cfl_rule": "auto"})
+    with pytest.raises(SceneError, match="numerics.cfl_rule: 'auto' is not one of fixed, damping"):
+        example_scene("couette", numerics={"cfl_rule": "auto"})
+    with pytest.raises(SceneError, match="numerics.cfl_rule: damping gives an acoustic C of .*barely damp"):
+        example_scene("couette", numerics={"cfl_rule": "damping", "density_diffusion": None},  # no damping
                       fluid={"viscosity": 1e-9})
-    with pytest.raises(SceneError, match="needs one viscosity"):
-        example_scene("hb_film", cfl_rule="damping")
+    with pytest.raises(SceneError, match="numerics.cfl_rule: damping needs one viscosity"):
+        example_scene("hb_film", numerics={"cfl_rule": "damping"})
     # a small cfl of the user's own is not the rule's doing: kept, not refused
-    assert example_scene("couette", cfl_rule="damping", cfl=0.01).cfl_acoustic == 0.01
+    assert example_scene("couette", numerics={"cfl_rule": "damping", "cfl": 0.01}).cfl_acoustic == 0.01
 
 
 @pytest.mark.slow
@@ -167,5 +154,5 @@ def test_rule_holds_the_coarse_conveyor_that_cfl_06_loses():
     """The coarse conveyor at cfl 0.6: fixed, the density guard stops it at 1.46 s;
     with the rule (C = 0.85 C* = 0.47) the fluid's largest |rho / rho0 - 1| stays at a stable
     run's 1.4-1.5 % through 2.5 s."""
-    case = coarse_conveyor_case(cfl=0.6, cfl_rule="damping")
+    case = coarse_conveyor_case(numerics={"cfl": 0.6, "cfl_rule": "damping"})
     assert worst_density_deviation(Simulation(build_scene(case)), 2.5) < 0.025

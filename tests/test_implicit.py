@@ -34,7 +34,7 @@ def dense_operator(sim):
     rows = np.flatnonzero(sim.kind[:sim.n_active] == 0)
     pos = np.full(sim.n, -1)
     pos[rows] = np.arange(rows.size)
-    C = np.diag(sim.out[sim.nq - 1][rows])
+    C = np.diag(sim.out[sim.slots.DIAG][rows])
     listed = np.zeros((rows.size, rows.size), dtype=int)
     m = sim.mass
     for t in range(pl.count.size):
@@ -160,52 +160,25 @@ def test_a_viscosity_wrong_name_is_refused_with_its_key():
     d = example_scene("couette").to_dict()
     d["numerics"]["viscous_update"] = "crank-nicolson"
     with pytest.raises(SceneError, match=r"numerics.viscous_update: 'crank-nicolson' is not one of "
-                                         r"explicit, implicit, substepped, auto, auto_substepped"):
+                                         r"explicit, implicit, substepped$"):
         scene_from_dict(d)
 
 
-@pytest.mark.parametrize("dp, ch, implicit_expected", [
-    (1.0e-3, 1.8, False),   # the viscous step 0.2 h^2/nu is 1.05 times below the acoustic 0.4 h/c0
-    (0.5e-3, 1.0, True),    # 3.8 times below
-    (0.5e-3, 1.3, False),   # 2.9 times below
-    (0.25e-3, 2.2, True),   # 3.4 times below
-])
-def test_auto_takes_the_implicit_update_where_the_viscous_limit_is_three_times_below(dp, ch, implicit_expected):
-    """``viscous_update: auto`` on the paper case at cfl 0.4, cfl_viscous 0.2: implicit where
-    cfl h / c0 >= 3 cfl_viscous h^2 / nu; the ratio is computed here from the case's own numbers."""
-    from solver.conveyor import build_scene, case_from_dict
-    from solver.scene import AUTO_IMPLICIT_RATIO, read_yaml
-    from tests.conftest import EXAMPLES
-    d = read_yaml(EXAMPLES / "conveyor_fast.yaml")
-    d.update(dp=dp, ch=ch, viscous_update="auto", cfl=0.4, cfl_viscous=0.2)
-    sc = build_scene(case_from_dict(d))
-    ratio = (0.4 * sc.h / sc.c0) / (0.2 * sc.h ** 2 / sc.nu)
-    assert (ratio >= AUTO_IMPLICIT_RATIO) == implicit_expected
-    assert sc.implicit_viscosity == implicit_expected
-    d["viscous_update"] = "explicit"
-    assert not build_scene(case_from_dict(d)).implicit_viscosity
-
-
-def test_the_run_records_which_viscous_update_auto_chose():
-    """The Couette channel (nu = 1e-3 m^2/s, tiny dp): its viscous limit is far below the
-    acoustic one, so ``auto`` runs it implicitly, and the output says so."""
+@pytest.mark.parametrize("update, cg, rkc", [("implicit", True, False), ("substepped", False, True),
+                                             ("explicit", False, False)])
+def test_the_run_records_its_viscous_update(update, cg, rkc):
+    """The Couette channel (nu = 1e-6 m^2/s, tiny dp) run briefly with each update: the output
+    names the update, and counts CG iterations for the implicit one, RKC stages for the
+    sub-stepped one, neither for the explicit one."""
     from solver.output import to_dataset
     from solver.run import run_scene
-    sc = example_scene("couette", numerics={"viscous_update": "auto"}, time={"end": 2e-4, "output_interval": 1e-4})
-    assert sc.implicit_viscosity
+    sc = example_scene("couette", numerics={"viscous_update": update}, time={"end": 2e-4, "output_interval": 1e-4})
+    assert sc.implicit_viscosity == (update != "explicit")
     res = run_scene(sc)
     assert res.status == "completed" and res.steps > 0
     attrs = to_dataset(res).attrs
-    assert attrs["viscous_update"] == "implicit" and attrs["cg_iterations"] > 0
-    sc = example_scene("couette", numerics={"viscous_update": "auto"}, cfl_viscous=1e3)
-    assert not sc.implicit_viscosity
-    # auto_substepped: the same choice, with RKC stages instead of CG
-    sc = example_scene("couette", numerics={"viscous_update": "auto_substepped"},
-                       time={"end": 2e-4, "output_interval": 1e-4})
-    attrs = to_dataset(run_scene(sc)).attrs
-    assert attrs["viscous_update"] == "substepped" and attrs["rkc_stages"] > 0 and attrs["cg_iterations"] == 0
-    sc = example_scene("couette", numerics={"viscous_update": "auto_substepped"}, cfl_viscous=1e3)
-    assert not sc.implicit_viscosity and sc.viscous_update_used == "explicit"
+    assert attrs["viscous_update"] == update
+    assert (attrs["cg_iterations"] > 0) == cg and (attrs["rkc_stages"] > 0) == rkc
 
 
 @pytest.mark.slow
@@ -224,7 +197,7 @@ def test_couette_reaches_the_exact_steady_profile_at_twenty_times_the_viscous_li
         reason = sim.step(min(sim.info.dt, sc.time.end - sim.t))
         assert not reason, reason
     dt3 = sc.h ** 2 / sc.nu
-    assert sim.info.dt > 20 * sc.cfl * dt3
+    assert sim.info.dt > 20 * sc.numerics.cfl * dt3
     s = sim.snapshot()
     f = s["kind"] == 0
     U0 = sc.walls[1].velocity[0]
@@ -245,7 +218,7 @@ def test_at_the_explicit_step_the_implicit_update_matches_the_exact_start_up(upd
     approximated by the mirror of the fluid's (solver/implicit.py)."""
     sc = example_scene("poiseuille", numerics={"viscous_update": update})
     sim = Simulation(sc)
-    dt = sc.cfl * sc.h ** 2 / sc.nu
+    dt = sc.numerics.cfl * sc.h ** 2 / sc.nu
     F = sc.gravity[0]
     u_max = F * L_CHANNEL ** 2 / (8 * sc.nu)
     errors = []
@@ -323,7 +296,7 @@ def test_the_substepped_update_is_runge_kutta_chebyshev_on_the_same_operator(dt_
     lam = np.linalg.eigvals(C).real
     beta = implicit.rkc_coefficients(s)[0]
     assert lam.min() > -1e-9 * lam.max() and dt * lam.max() <= beta
-    assert lam.max() <= implicit.eigenvalue_bound(sim.out[sim.nq - 1], sim.kind, sim.n_active)
+    assert lam.max() <= implicit.eigenvalue_bound(sim.out[sim.slots.DIAG], sim.kind, sim.n_active)
 
 
 FILM_ROWS = 19  # the film of SPEC section 7 is h_n = 18.76 mm deep; 19 whole rows at dp = 1 mm
@@ -341,9 +314,9 @@ def fast_scheme_film(update: str, dp: float = 1.0e-3, ch: float = 1.8):
         "film", dp=dp, ch=ch, periodic_x=[0.0, L],
         fluid={"blocks": [{"x": [0.0, L], "z": [0.0, H]}]},
         walls=[{"name": "bed", "x": [0.0, L], "z": [-4 * dp, 0.0]}],
-        numerics={"viscous_update": update, "viscous_correction": True, "viscous_normalisation": True,
-                 "mdbc_velocity": "corrected", "volume_relaxation": 0.1,
-                 "density_diffusion_reference": "column", "shifting": {"method": "skillen"}})
+        numerics={"viscous_update": update, "viscous_correction": True,
+                  "mdbc_velocity": "corrected", "volume_relaxation": 0.1,
+                  "density_diffusion_reference": "column", "shifting": {"method": "skillen"}})
 
 
 def film_error(sim) -> float:
@@ -359,7 +332,7 @@ def film_error(sim) -> float:
 def test_at_the_fast_examples_step_the_substepped_film_is_exact_and_the_explicit_one_diverges(update, outcome):
     """examples/conveyor_fast.yaml's step, C = 0.6 on the acoustic limit h / c0, is at dp = 1 mm
     0.31 h^2 / nu, the explicit viscous edge (bounded at 0.30, diverged at 0.35) and beyond the
-    joint one (docs/numerics.md, "The two limits add up"). On the film from rest to 0.5 s (5.7
+    joint one (docs/numerics.md). On the film from rest to 0.5 s (5.7
     viscous times H^2 / nu), sub-stepped (2 RKC stages a step) it reaches the exact profile:
     measured 0.235 % of the surface velocity, as the explicit update at its own step, C_nu =
     0.2 (0.235 %; with SPEC's Shepard ghost velocity and no normaliser both read 1.170 %); bound

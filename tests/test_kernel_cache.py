@@ -88,7 +88,7 @@ event.register("numba:compile", Count())
 for shifting in ("skillen", "none"):
     with open(sys.argv[1]) as fh:
         d = yaml.safe_load(fh)
-    d["numerics" if "numerics" in d else "numerics"]["shifting"] = {"method": shifting}
+    d.setdefault("numerics", {})["shifting"] = {"method": shifting}
     Simulation(scene_from_dict(d)).step()
 numba.njit(lambda v: v + 1)(1)
 print(sum(n for name, n in counts.items() if "pair_loop" in name),

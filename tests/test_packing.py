@@ -12,11 +12,11 @@ from tests.conftest import example_scene
 BETA = 0.1
 
 
-def channel_sim(volume_scale: float = 1.0) -> Simulation:
-    """The closed channel at rest with lind shifting and the relaxation; the fluid particles'
+def channel_sim(volume_scale: float = 1.0, shifting: str = "lind") -> Simulation:
+    """The closed channel at rest with ``shifting`` and the relaxation; the fluid particles'
     volumes m / rho scaled by ``volume_scale`` (their spacing unchanged)."""
-    scene = example_scene("channel", numerics={"shifting": {"method": "lind"},
-                                              "volume_relaxation": BETA})
+    scene = example_scene("channel", numerics={"shifting": {"method": shifting},
+                                               "volume_relaxation": BETA})
     parts = build_particles(scene)
     parts.mass[parts.kind == 0] *= volume_scale
     return Simulation(scene, parts)
@@ -30,14 +30,33 @@ def relaxed_change(sim: Simulation) -> np.ndarray:
 
 
 def concentration(sim: Simulation) -> np.ndarray:
-    return sim.out[sim.volume_slot] + sim.mass / sim.rho * 7.0 / (4.0 * np.pi * sim.h ** 2)
+    return sim.out[sim.slots.VOLC] + sim.mass / sim.rho * 7.0 / (4.0 * np.pi * sim.h ** 2)
 
 
-def test_a_lattice_is_at_the_lattice_concentration_and_is_left_alone():
-    sim = channel_sim()
+@pytest.mark.parametrize("shifting", ["lind", "none"])
+def test_a_lattice_is_at_the_lattice_concentration_and_is_left_alone(shifting):
+    """With or without shifting: the relaxation needs only the packing sums, which the pair loop
+    computes for it when shifting is off."""
+    sim = channel_sim(shifting=shifting)
     f = sim.kind == 0
     np.testing.assert_allclose(concentration(sim)[f], sim.n_lattice, rtol=1e-12)
     assert np.abs(relaxed_change(sim)).max() < 1e-14
+
+
+def test_without_shifting_the_relaxation_keeps_a_lattice_at_rest():
+    """Shifting none with the relaxation: the scene is accepted and runs, and the channel's
+    lattice at rest stays at rest, in place and at rho0, step after step."""
+    sim = channel_sim(shifting="none")
+    assert sim.pair_options.packing == 2 and sim.slots.VOLC >= 0
+    x0 = sim.snapshot()
+    for _ in range(20):
+        assert sim.step() == ""
+    x1 = sim.snapshot()
+    f = x0["kind"] == 0
+    dp = sim.scene.dp
+    assert np.abs(x1["x"][f] - x0["x"][f]).max() < 1e-12 * dp
+    assert np.abs(x1["z"][f] - x0["z"][f]).max() < 1e-12 * dp
+    assert np.abs(x1["rho"][f] / sim.rho0 - 1.0).max() < 1e-12
 
 
 @pytest.mark.parametrize("scale", [1.0 / 1.001, 1.001])
@@ -83,11 +102,11 @@ def test_a_free_surface_is_not_taken_for_loose_packing():
     assert np.abs(change[f]).max() < lam * 0.004
 
 
-@pytest.mark.parametrize("physics, message", [
-    ({"volume_relaxation": 0.1}, "needs shifting"),
+@pytest.mark.parametrize("numerics, message", [
     ({"volume_relaxation": -1.0, "shifting": {"method": "lind"}}, "beta > 0"),
+    ({"volume_relaxation": 0.0}, "beta > 0"),
     ({"volume_relaxation": "fast", "shifting": {"method": "lind"}}, "expected a number"),
 ])
-def test_bad_settings_name_the_key(physics, message):
-    with pytest.raises(SceneError, match=f"physics.volume_relaxation: .*{message}"):
-        example_scene("channel", numerics=physics)
+def test_bad_settings_name_the_key(numerics, message):
+    with pytest.raises(SceneError, match=f"numerics.volume_relaxation: .*{message}"):
+        example_scene("channel", numerics=numerics)

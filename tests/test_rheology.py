@@ -36,7 +36,7 @@ def steady_state(name: str, **changes):
     sim._evaluate(sim.t)  # the gradient sums of the final state
     n = sim.n_active
     idx = np.flatnonzero(sim.kind[:n] == 0)
-    gamma = np.array([rheology.strain_rate(sim.out, i) for i in idx])
+    gamma = np.array([rheology.strain_rate(sim.out, i, sim.slots) for i in idx])
     return scene, sim.z[idx], sim.u[idx], gamma, sim.nu_p[idx]
 
 

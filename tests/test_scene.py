@@ -41,17 +41,48 @@ def test_yaml_exponent_without_dot_is_read_as_number():
 def test_impossible_values():
     assert "dp: must be a positive" in err({"dp": 0.0})
     assert "dp: must be a positive" in err({"dp": -1e-3})
-    assert "cfl" in err({"cfl": -0.2})
-    assert "physics.shifting.method" in err({"numerics": {"shifting": {"method": "magic"}}})
+    assert "numerics.cfl: must be a positive" in err({"numerics": {"cfl": -0.2}})
+    assert "numerics.shifting.method" in err({"numerics": {"shifting": {"method": "magic"}}})
     assert "none, skillen, lind" in err({"numerics": {"shifting": {"method": "magic"}}})
-    assert "physics.boundary" in err({"numerics": {"boundary": "slip"}})
-    assert "physics.density_update: 'verlet' is not one of explicit, leapfrog" in err(
-        {"numerics": {"density_update": "verlet"}})
-    assert "physics.shifting.min_speed: must be a finite number >= 0" in err(
+    assert "numerics.boundary" in err({"numerics": {"boundary": "slip"}})
+    assert "numerics.viscous_update: 'auto' is not one of explicit, implicit, substepped" in err(
+        {"numerics": {"viscous_update": "auto"}})
+    assert "numerics.shifting.min_speed: must be a finite number >= 0" in err(
         {"numerics": {"shifting": {"method": "skillen", "min_speed": -0.1}}})
-    assert "applies to method skillen only" in err(
-        {"numerics": {"shifting": {"method": "lind", "min_speed": 0.05}}})
     assert "fluid.blocks[0].x" in err({"fluid": {"blocks": [{"x": [1e-3, 0.0], "z": [0.0, 1e-3]}]}})
+
+
+def test_ch_must_lie_in_one_to_four():
+    """h / dp below 1 leaves a particle's support too few neighbours; the range is [1, 4]."""
+    for ch in (0.5, 0.99, 4.5):
+        msg = err({"ch": ch})
+        assert msg.startswith("ch: ") and "[1, 4]" in msg, msg
+    for ch in (1.0, 4.0):  # the tank: no periodic period for a wide support to outgrow
+        assert scene_from_dict(merge(example_dict("hydrostatic"), {"ch": ch})).ch == ch
+
+
+def test_removed_and_moved_keys_are_refused_saying_where_they_went():
+    assert "physics: renamed numerics" in err({"physics": {"boundary": "mdbc"}})
+    assert "cfl: now numerics.cfl" in err({"cfl": 0.2})
+    assert "cfl_rule: now numerics.cfl_rule" in err({"cfl_rule": "fixed"})
+    assert "cfl_viscous: removed" in err({"cfl_viscous": 0.2})
+    for key in ("density_update", "viscous_normalisation", "cfl_viscous"):
+        msg = err({"numerics": {key: False}})
+        assert "unknown key(s) " + key in msg, msg
+    for key in ("max_shift", "density_correction", "correction_limit", "surface_threshold"):
+        msg = err({"numerics": {"shifting": {"method": "lind", key: 0.1}}})
+        assert "scene.numerics.shifting: unknown key(s) " + key in msg, msg
+
+
+def test_each_shifting_method_ignores_the_others_key():
+    """min_speed is skillen's and near_surface lind's; one scheme serves both methods, so the
+    other method accepts the key and keeps it unused."""
+    lind = scene_from_dict(merge(example_dict("poiseuille"),
+                                 {"numerics": {"shifting": {"method": "lind", "min_speed": 0.05}}}))
+    assert lind.numerics.shifting.min_speed == 0.05
+    skillen = scene_from_dict(merge(example_dict("poiseuille"),
+                                    {"numerics": {"shifting": {"method": "skillen", "near_surface": "tangential"}}}))
+    assert skillen.numerics.shifting.near_surface == "tangential"
 
 
 def test_missing_required_key():

@@ -1,4 +1,4 @@
-"""Order of the time integration (docs/numerics.md, "Time integration").
+"""Order of the time integration (docs/numerics.md).
 
 The step evaluates forces at mid-step positions with the velocities of the step's start, so
 the velocity update is first order in dt for the velocity-dependent terms (viscosity,
@@ -42,12 +42,17 @@ def test_velocity_update_is_first_order_in_dt():
     assert diffs[0] * 2 < 0.005 * U0  # |u(dt) - u(0)| ~ 2 |u(dt) - u(dt/2)| for order 1
 
 
-def test_the_viscous_limit_takes_its_own_coefficient():
-    """dt = min(C dt1, C dt2, C_nu dt3); without C_nu it is C min(dt1, dt2, dt3) (SPEC eq. 7)."""
+def test_the_step_is_one_c_times_the_smallest_limit():
+    """dt = C min(dt1, dt2, dt3) (docs/scheme.md section 6): one C for the force and viscous
+    limits; ``cfl_acoustic`` sets the acoustic limit's own C, and an implicit or sub-stepped
+    laminar term (``viscous_limit`` false) drops dt3, which is still reported."""
     from solver.integrate import time_step
     h, amax, vmax, c0, nu = 1.8e-3, 9.81, 0.1, 4.29, 5.6 / 1383  # the paper case at dp = 1 mm
     dt1, dt2, dt3 = math.sqrt(h / amax), h / (c0 + vmax), h * h / nu
     assert time_step(0.2, h, amax, vmax, c0, nu) == (0.2 * dt2, 1, (dt1, dt2, dt3))
-    assert time_step(0.4, h, amax, vmax, c0, nu, cfl_viscous=0.25)[:2] == (0.4 * dt2, 1)  # acoustic
-    assert time_step(0.4, h, amax, vmax, c0, nu, cfl_viscous=0.2)[:2] == (0.2 * dt3, 2)  # 1.600 < 1.640e-4
     assert time_step(0.4, h, amax, vmax, c0, nu)[:2] == (0.4 * dt2, 1)  # one C: the acoustic limit
+    # a fluid 5 times as viscous: its dt3 = 1.60e-4 s < dt2 = 4.10e-4 s, the viscous limit binds
+    dt3_viscous = h * h / (5 * nu)
+    assert time_step(0.4, h, amax, vmax, c0, 5 * nu)[:2] == (0.4 * dt3_viscous, 2)
+    assert time_step(0.4, h, amax, vmax, c0, 5 * nu, viscous_limit=False) == (0.4 * dt2, 1, (dt1, dt2, dt3_viscous))
+    assert time_step(0.4, h, amax, vmax, c0, nu, cfl_acoustic=0.3)[:2] == (0.3 * dt2, 1)
