@@ -1,5 +1,5 @@
 """A violent, low-viscosity flow: the dam break of examples/dambreak.yaml, run past the
-impact on the opposite wall (docs/numerics.md, "Violent flows").
+impact on the opposite wall (docs/numerics.md).
 
 It must run without any guard firing (density, penetration, domain, time step), the surge
 must reach the right wall and run up it, the front must never outrun Ritter's ideal

@@ -1,4 +1,4 @@
-"""Fourtakas density diffusion (SPEC section 6): diffusive, and silent on a column at rest."""
+"""Fourtakas density diffusion (docs/scheme.md section 6): diffusive, and silent on a column at rest."""
 import math
 
 import numpy as np
@@ -58,7 +58,7 @@ def test_density_bump_decays_faster_with_diffusion():
 
 def diffusion_rate_at_rest(reference, dp, ch):
     """|drho/dt| / rho of the diffusion term alone on the hydrostatic tank at rest, and the
-    bulk rate SPEC's rho^H leaves, 11 delta h g^2 / c0^3 (see the next test)."""
+    bulk rate the paper's rho^H leaves, 11 delta h g^2 / c0^3 (see the next test)."""
     phys = {"density_diffusion_reference": reference}
     on = Simulation(example_scene("hydrostatic", dp=dp, ch=ch, numerics=phys))
     off = Simulation(example_scene("hydrostatic", dp=dp, ch=ch, numerics={"density_diffusion": None}))
@@ -72,7 +72,7 @@ def diffusion_rate_at_rest(reference, dp, ch):
 
 @pytest.mark.slow
 def test_spec_reference_leaves_a_bulk_density_sink_on_a_column_at_rest():
-    """SPEC's rho^H_ab = rho0 ((1 + x)^(1/7) - 1) is exact only for a pair whose upper
+    """the paper's rho^H_ab = rho0 ((1 + x)^(1/7) - 1) is exact only for a pair whose upper
     particle is at zero pressure: its curvature in z_b - z_a has the opposite sign to the
     Tait column's. In the bulk the sum leaves drho/dt / rho = -11 delta h g^2 / c0^3
     (the kernel-sum Laplacian of the (11/98) rho0 k^2 dz^2 mismatch, k = 7 g / c0^2), and
@@ -88,7 +88,7 @@ def test_spec_reference_leaves_a_bulk_density_sink_on_a_column_at_rest():
 def test_column_reference_vanishes_on_a_column_at_rest():
     """u = 0 and rho the Tait column at rest (rho^6 linear in depth): the "column" rho^H_ab
     cancels rho_a - rho_b for every pair, bed and surface rows included. Bound: a
-    thousandth of the bulk sink SPEC's form leaves (measured: 4e-5 of it)."""
+    thousandth of the bulk sink the paper's form leaves (measured: 4e-5 of it)."""
     for dp, ch in ((2e-3, 1.5), (1e-3, 1.8)):
         rate, _, bulk = diffusion_rate_at_rest("column", dp, ch)
         assert np.abs(rate).max() < 1e-3 * bulk, (dp, np.abs(rate).max(), bulk)

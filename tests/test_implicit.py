@@ -299,11 +299,11 @@ def test_the_substepped_update_is_runge_kutta_chebyshev_on_the_same_operator(dt_
     assert lam.max() <= implicit.eigenvalue_bound(sim.out[sim.slots.DIAG], sim.kind, sim.n_active)
 
 
-FILM_ROWS = 19  # the film of SPEC section 7 is h_n = 18.76 mm deep; 19 whole rows at dp = 1 mm
+FILM_ROWS = 19  # the film of docs/scheme.md section 7 is h_n = 18.76 mm deep; 19 whole rows at dp = 1 mm
 
 
 def fast_scheme_film(update: str, dp: float = 1.0e-3, ch: float = 1.8):
-    """The film of SPEC section 7 (examples/film.yaml: the paper fluid on the 15.3 deg incline,
+    """The film of docs/scheme.md section 7 (examples/film.yaml: the paper fluid on the 15.3 deg incline,
     periodic over 24 dp) FILM_ROWS whole rows deep (19.0 mm at dp = 1 mm, the lattice filling its
     depth exactly), at dp and Ch with the physics of examples/conveyor_fast.yaml (the consistent
     laminar term with the corrected ghost velocity and the normaliser, the volume relaxation
@@ -335,7 +335,7 @@ def test_at_the_fast_examples_step_the_substepped_film_is_exact_and_the_explicit
     joint one (docs/numerics.md). On the film from rest to 0.5 s (5.7
     viscous times H^2 / nu), sub-stepped (2 RKC stages a step) it reaches the exact profile:
     measured 0.235 % of the surface velocity, as the explicit update at its own step, C_nu =
-    0.2 (0.235 %; with SPEC's Shepard ghost velocity and no normaliser both read 1.170 %); bound
+    0.2 (0.235 %; with the paper's Shepard ghost velocity and no normaliser both read 1.170 %); bound
     0.294 % (plus 25 %). The explicit update at the same step diverged at step 318 (0.08 s)."""
     sc = fast_scheme_film(update)
     sim = Simulation(sc)

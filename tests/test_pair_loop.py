@@ -3,7 +3,7 @@
 The loop visits each pair from a half stencil of z-sorted columns and lists each particle's
 candidates within 2h before summing (solver/forces.py). Here a disordered, periodic fluid with
 a moving wall below it, random velocities, densities and last shifts is evaluated once, and
-every fluid particle's sums are compared with the same SPEC section 6 terms summed directly
+every fluid particle's sums are compared with the same docs/scheme.md section 6 terms summed directly
 over all particle pairs (nearest periodic image), which needs no neighbour search.
 """
 import numpy as np
@@ -49,7 +49,7 @@ def last_shift(x, z):
 
 
 def direct_sums(sim: Simulation, sdx, sdz) -> dict:
-    """SPEC section 6's pair sums of every particle over all others within 2h, by the nearest
+    """docs/scheme.md section 6's pair sums of every particle over all others within 2h, by the nearest
     periodic image, from the arrays the pair loop read (``sdx``, ``sdz``: the last shift)."""
     n = sim.n_active
     x, z, u, w, p, m, kind, cell = (a[:n] for a in (sim.x, sim.z, sim.u, sim.w, sim.p, sim.mass, sim.kind,

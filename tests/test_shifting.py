@@ -1,4 +1,4 @@
-"""Shifting (SPEC section 6): a uniform lattice stays put, a disordered one is ordered."""
+"""Shifting (docs/scheme.md section 6): a uniform lattice stays put, a disordered one is ordered."""
 import math
 
 import numpy as np
@@ -99,7 +99,7 @@ def test_skillen_speed_floor_orders_the_interior_of_fluid_at_rest():
     its disorder. With ``min_speed`` the speed is max(|u|, min_speed) where no wall is within 2h,
     and there the same disordered fluid at rest is ordered as the
     moving one above (30 shifts, each over 0.1 h of travel at min_speed); the rows within reach
-    of a wall keep SPEC's |u| = 0 and do not move."""
+    of a wall keep the paper's |u| = 0 and do not move."""
     results = {}
     for floor in (0.0, U):
         scene, sim = disordered_channel_at_rest(floor)
@@ -246,7 +246,7 @@ def shifted_thin_film(depth_dp, near_surface):
 
 @pytest.mark.parametrize("near_surface", ["none", "tangential"])
 def test_lind_near_the_free_surface(near_surface):
-    """Within 2h of the free surface of a disordered film 4 dp deep, SPEC's lind does not shift;
+    """Within 2h of the free surface of a disordered film 4 dp deep, the paper's lind does not shift;
     with ``near_surface: tangential`` the particles there move, and only along the surface: the
     shift has no component along the normal n of the nearby surface particles (dr . n = 0 to
     round-off wherever neither the clip nor a wall altered it)."""
@@ -269,7 +269,7 @@ def test_lind_near_the_free_surface(near_surface):
 
 def test_lind_tangential_leaves_the_surface_at_a_wall_alone():
     """Where the free surface meets a wall (a surface particle with a wall particle within 2h),
-    the tangential shift does not move it, as SPEC's lind; the particles under it, within 2h of
+    the tangential shift does not move it, as the paper's lind; the particles under it, within 2h of
     the surface and of the wall, still shift along the surface. Film 2 dp deep: every particle
     is within 2h of the bed."""
     r = shifted_thin_film(2, "tangential")

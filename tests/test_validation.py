@@ -1,4 +1,4 @@
-"""Solver against the exact solutions of SPEC section 7."""
+"""Solver against the exact solutions of docs/scheme.md section 7."""
 import math
 
 import numpy as np
