@@ -320,7 +320,7 @@ def fast_scheme_film(update: str, dp: float = 1.0e-3, ch: float = 1.8):
 
 
 def film_error(sim) -> float:
-    """RMS of u - u_exact over the fluid particles, over the exact surface velocity (SPEC
+    """RMS of u - u_exact over the fluid particles, over the exact surface velocity (docs/scheme.md
     section 7's semi-parabolic profile at the depth the rows fill)."""
     f = sim.kind[:sim.n_active] == 0
     return exact.film_rms_error(sim.z[:sim.n_active][f], sim.u[:sim.n_active][f], FILM_ROWS * sim.scene.dp,
