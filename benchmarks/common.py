@@ -97,6 +97,14 @@ def now() -> str:
     return datetime.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
 
 
+def load() -> str:
+    """The host's load average over 1, 5 and 15 minutes (a busy host times everything slower)."""
+    try:
+        return "load " + " / ".join(f"{v:.1f}" for v in os.getloadavg())
+    except OSError:
+        return "load unknown"
+
+
 def host() -> str:
     """CPU model, usable cores, OS, Python and numba versions."""
     try:
@@ -276,4 +284,4 @@ def summary(text: str) -> None:
 
 
 if __name__ == "__main__":
-    print(f"{now()}; {host()}; commit {commit()}")
+    print(f"{now()}; {host()}; {load()}; commit {commit()}")

@@ -15,8 +15,11 @@ finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at an
 its paper-Ch run's dt, rate and N times their Ch ratio at the coarsest dp.
 
     python -m benchmarks.paper_grid [--config config/paper.yaml] [--threads 2] [--time 0.05] [--fine-time 0.02]
-        [--t-sim 4.0 lind=4.2 skillen@0.25=5] [--shifting skillen lind] [--coarse-only] [--set KEY=VALUE ...]
-        [--out DIR] [--reuse]
+        [--t-sim 4.0 lind=4.2 skillen@0.25=5] [--shifting skillen lind] [--coarsest N] [--paper-ch-only]
+        [--coarse-only] [--set KEY=VALUE ...] [--out DIR] [--reuse]
+
+--shifting, --coarsest and --paper-ch-only project only part of the grid (--quick: Skillen's
+cases at the paper Ch and the two coarsest dp).
 """
 from __future__ import annotations
 
@@ -26,15 +29,24 @@ from pathlib import Path
 
 from benchmarks import common
 
-QUICK = {"coarse_only": True, "shifting": ["skillen"], "time": 0.01, "fine_time": 0.002}
+QUICK = {"paper_ch_only": True, "shifting": ["skillen"], "coarsest": 2, "time": 0.01}
 
 
-def grid_cases(cfg: dict, methods) -> dict:
-    """{(dp, ch, method): (solver case dict of realisation 0, realisations)} of the grid."""
+def paper_ch(cfg: dict) -> float:
+    """The grid's paper Ch (grid.paper_ch where the grid has it, else its middle Ch)."""
+    chs = sorted(cfg["grid"]["ch"])
+    return cfg["grid"].get("paper_ch") if cfg["grid"].get("paper_ch") in chs else chs[len(chs) // 2]
+
+
+def grid_cases(cfg: dict, methods=None, coarsest: int | None = None, paper_ch_only: bool = False) -> dict:
+    """{(dp, ch, method): (solver case dict of realisation 0, realisations)} of the grid (only
+    ``methods``, the ``coarsest`` dp and the paper Ch where given)."""
     from study.config import case_dict, cases
+    dps = sorted({c.dp for c in cases(cfg) if c.on_grid}, reverse=True)[:coarsest]
     out: dict = {}
     for c in cases(cfg):
-        if not c.on_grid or (methods and c.shifting not in methods):
+        if (not c.on_grid or (methods and c.shifting not in methods) or c.dp not in dps
+                or (paper_ch_only and c.ch != paper_ch(cfg))):
             continue
         key = (c.dp, c.ch, c.shifting)
         if c.realisation == 0:
@@ -80,6 +92,8 @@ def main(argv=None) -> int:
     ap.add_argument("--fine-time", type=float, default=0.02, help="simulated seconds below dp = 0.4 mm")
     ap.add_argument("--t-sim", nargs="+", default=["4.0"], metavar="[METHOD[@DP_MM]=]T")
     ap.add_argument("--shifting", nargs="+", default=None, help="only these methods' cases (default: all)")
+    ap.add_argument("--coarsest", type=int, default=None, metavar="N", help="only the N coarsest dp (default: all)")
+    ap.add_argument("--paper-ch-only", action="store_true", help="only the paper Ch")
     ap.add_argument("--coarse-only", action="store_true",
                     help="measure every Ch at the coarsest dp only, the finer dp at the paper Ch")
     ap.add_argument("--reuse", action="store_true", help="project from OUT/runs.json, measure nothing")
@@ -87,13 +101,10 @@ def main(argv=None) -> int:
     from study.config import load
     cfg = load(a.config)
     common.set_threads(a.threads)
-    grid = grid_cases(cfg, a.shifting)
+    grid = grid_cases(cfg, a.shifting, a.coarsest, a.paper_ch_only)
     dps = sorted({k[0] for k in grid}, reverse=True)
-    chs = sorted({k[1] for k in grid})
-    paper_ch = cfg["grid"].get("paper_ch")
-    paper_ch = paper_ch if paper_ch in chs else chs[len(chs) // 2]
-    coarse = dps[0]
-    to_measure = [k for k in grid if not a.coarse_only or k[0] == coarse or k[1] == paper_ch]
+    pch, coarse = paper_ch(cfg), dps[0]
+    to_measure = [k for k in grid if not a.coarse_only or k[0] == coarse or k[1] == pch]
     a.out.mkdir(parents=True, exist_ok=True)
     runs_file = a.out / "runs.json"
     if a.reuse:
@@ -118,7 +129,7 @@ def main(argv=None) -> int:
         if own is not None:
             n, dt, rate, startup, how = own["particles"], own["dt"], own["rate"], own["startup"], "measured"
         else:  # the paper-Ch run at this dp, times the Ch ratios at the coarsest dp
-            base, c1, p1 = runs[(dp, paper_ch, m)], runs[(coarse, ch, m)], runs[(coarse, paper_ch, m)]
+            base, c1, p1 = runs[(dp, pch, m)], runs[(coarse, ch, m)], runs[(coarse, pch, m)]
             n = base["particles"] * c1["particles"] / p1["particles"]
             dt, rate = base["dt"] * c1["dt"] / p1["dt"], base["rate"] * c1["rate"] / p1["rate"]
             startup, how = base["startup"], "scaled"
@@ -135,8 +146,9 @@ def main(argv=None) -> int:
     print()
     print(common.table(["dp [mm]", "Ch", "shifting", "runs", "how", "dt [s]", "M particle-steps/s", "T_sim [s]",
                         "to steady + window [h]", "max_time [s]", "to max_time [h]"], rows))
-    methods = " and ".join(sorted({k[2] for k in grid}))
-    common.summary(f"{a.config.name} ({methods}), one run at a time on {a.threads} threads: "
+    part = (" and ".join(sorted({k[2] for k in grid})) + ", dp " + ", ".join(f"{dp * 1e3:g}" for dp in dps) + " mm, Ch "
+            + ", ".join(f"{ch:g}" for ch in sorted({k[1] for k in grid})))
+    common.summary(f"{a.config.name} ({part}), one run at a time on {a.threads} threads: "
                    f"{total / 3600:.1f} h to steady (T_sim {' '.join(a.t_sim)} s), "
                    f"{total_max / 3600:.1f} h to max_time")
     return 0

@@ -48,7 +48,7 @@ def main(argv=None) -> int:
     ap.add_argument("--only", nargs="+", default=None, choices=[b[0] for b in BENCHMARKS], metavar="NAME")
     ap.add_argument("--output", type=Path, default=common.ROOT / "benchmarks" / "RESULTS.md")
     a = common.parse(ap, argv)
-    started, host, rev = common.now(), common.host(), common.commit()
+    started, host, rev, load_before = common.now(), common.host(), common.commit(), common.load()
     machine = f"{common.cpu_model()}, {common.usable_cores()} cores"
     rows, sections, failed = [], [], 0
     for name, args, takes_out in BENCHMARKS:
@@ -76,7 +76,7 @@ def main(argv=None) -> int:
         + (" Quick mode: each benchmark's smallest mode, which shows the method at work; the figures a "
            "claim cites come from the full runs (see each benchmark's --help)." if a.quick else ""),
         "",
-        f"Host: {host}.",
+        f"Host: {host}; {load_before} when it started, {common.load()} when it ended.",
         "",
         common.table(["benchmark", "command", "date", "host", "wall [s]", "figures"], rows),
         "",
