@@ -179,9 +179,19 @@ MOVED_CASE_KEYS = {
 }
 
 
+def particles_across(case: "ConveyorCase") -> float:
+    """h_n / dp, the resolution a preset reads; for physics too wrong to give h_n, the presets'
+    default (the case's validation then names the wrong key)."""
+    try:
+        ratio = case.h_n / case.dp
+    except (ArithmeticError, ValueError, TypeError):
+        return schemes.RESOLVED_DEPTH
+    return ratio if math.isfinite(ratio) else schemes.RESOLVED_DEPTH
+
+
 def preset_numerics(case: "ConveyorCase") -> dict:
     """The numerics block of the case's scheme (``schemes.preset``)."""
-    return schemes.preset(case.scheme, case.belt.speed, case.newtonian, case.h_n / case.dp).get("numerics", {})
+    return schemes.preset(case.scheme, case.belt.speed, case.newtonian, particles_across(case)).get("numerics", {})
 
 
 def resolve_scheme(data: dict) -> dict:
@@ -192,7 +202,8 @@ def resolve_scheme(data: dict) -> dict:
     if name not in schemes.SCHEMES:
         raise SceneError(f"case.scheme: {name!r} is not one of {', '.join(schemes.SCHEMES)}")
     numerics = data.get("numerics")
-    method = numerics.get("shifting", {}).get("method") if isinstance(numerics, dict) else None
+    shifting = numerics.get("shifting") if isinstance(numerics, dict) else None
+    method = shifting.get("method") if isinstance(shifting, dict) else None
     if method is not None and method != data.get("shifting", ConveyorCase.shifting):
         raise SceneError(f"case.numerics.shifting.method: {method!r}, but the case's shifting key, which "
                          f"sets the method, is {data.get('shifting', ConveyorCase.shifting)!r}: set shifting only")
@@ -201,7 +212,7 @@ def resolve_scheme(data: dict) -> dict:
     physical = parse_into(ConveyorCase, {**{k: v for k, v in data.items() if k != "numerics"},
                                          "scheme": "spec"}, "case")
     return schemes.merge(schemes.preset(name, physical.belt.speed, physical.newtonian,
-                                        physical.h_n / physical.dp), data)
+                                        particles_across(physical)), data)
 
 
 def case_from_dict(data) -> ConveyorCase:
