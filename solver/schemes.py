@@ -13,7 +13,7 @@ import copy
 DEFAULT_SCHEME = "surge"
 SKILLEN_MIN_SPEED = 0.5  # surge: Skillen's shifting speed at least this fraction of the belt speed
 # surge: C_CFL 0.6 where the normal depth holds at least this many particles (the paper's least
-# resolution), 0.4 on coarser grids, where 0.6 held but degraded the metrics (docs/numerics.md)
+# resolution), 0.4 on coarser grids, where 0.6 held but moved the metrics (docs/numerics.md)
 RESOLVED_DEPTH = 15.0
 CFL, COARSE_CFL = 0.6, 0.4
 
