@@ -117,12 +117,13 @@ def host() -> str:
 
 
 def commit() -> str:
-    """The repository's commit, with ``+`` when the tree has uncommitted changes."""
+    """The repository's commit, with ``+`` when the tree has uncommitted changes (but for
+    RESULTS.md, which the report rewrites)."""
     try:
         rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True,
                              check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
-                               capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".",
+                                ":!benchmarks/RESULTS.md"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
         return rev + ("+" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
