@@ -129,9 +129,16 @@ def commit() -> str:
         return "unknown"
 
 
-def set_threads(threads: int) -> None:
+def max_threads() -> int:
+    """The most threads numba may run here (NUMBA_NUM_THREADS, else the usable cores)."""
+    return int(os.environ.get("NUMBA_NUM_THREADS") or usable_cores())
+
+
+def set_threads(threads: int) -> int:
+    """Run numba on ``threads`` threads (at most ``max_threads()``); the number it runs on."""
     import numba
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    return numba.get_num_threads()
 
 
 # ---- cases -----------------------------------------------------------------------------------
@@ -221,7 +228,8 @@ def front(case: Path, sets, out: Path, threads: int, reuse: bool = False) -> Pat
     too) to ``out``; with ``reuse`` an existing ``out`` is kept."""
     if not (reuse and out.exists()):
         out.parent.mkdir(parents=True, exist_ok=True)
-        cmd = [sys.executable, "-m", "solver", "front", str(case), "-o", str(out), "--threads", str(threads),
+        cmd = [sys.executable, "-m", "solver", "front", str(case), "-o", str(out),
+               "--threads", str(max(1, min(threads, max_threads()))),
                "--quiet", "--no-checkpoint", "--allow-diverged"] + [a for s in sets for a in ("--set", s)]
         print(f"# {' '.join(cmd[1:])}", file=sys.stderr, flush=True)
         subprocess.run(cmd, check=True, cwd=ROOT)

@@ -59,7 +59,7 @@ def main(argv=None) -> int:
     ap.add_argument("--warmup", type=int, default=5)
     ap.add_argument("--rows", type=int, default=16, help="kernels listed")
     a = common.parse(ap, argv, QUICK)
-    common.set_threads(a.threads)
+    a.threads = common.set_threads(a.threads)
     if a.case is not None:
         data, scene = common.set_shifting(common.read_case(a.case, a.sets), a.shifting), a.case.name
     else:

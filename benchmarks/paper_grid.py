@@ -100,7 +100,7 @@ def main(argv=None) -> int:
     a = common.parse(ap, argv, QUICK)
     from study.config import load
     cfg = load(a.config)
-    common.set_threads(a.threads)
+    a.threads = common.set_threads(a.threads)
     grid = grid_cases(cfg, a.shifting, a.coarsest, a.paper_ch_only)
     dps = sorted({k[0] for k in grid}, reverse=True)
     pch, coarse = paper_ch(cfg), dps[0]

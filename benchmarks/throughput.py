@@ -45,7 +45,7 @@ def jitter(sim, amplitude: float, seed: int = 1) -> None:
 
 def measure(data: dict, threads: int, steps: int, jitter_dp: float = 0.0) -> dict:
     """Time ``steps`` steps of the case or scene ``data`` on ``threads`` threads."""
-    common.set_threads(threads)
+    threads = common.set_threads(threads)
     sim = common.simulation(data)
     if jitter_dp > 0:
         jitter(sim, jitter_dp)

@@ -87,7 +87,7 @@ def main(argv=None) -> int:
     ap.add_argument("--update", default=None, help="the scene's viscous_update (default: the scene's own)")
     ap.add_argument("--json", action="store_true", help="one JSON object a run as well")
     a = common.parse(ap, argv, QUICK)
-    common.set_threads(a.threads)
+    a.threads = common.set_threads(a.threads)
     scene = film(a.case, a.dp, a.ch, a.end, a.update, a.sets)
     rows = []
     for C in a.c:
