@@ -237,11 +237,9 @@ def front(case: Path, sets, out: Path, threads: int, reuse: bool = False) -> Pat
 
 
 def run_case(run):
-    """The solver case a front run (its dataset) ran."""
-    import yaml
-
-    from solver.conveyor import case_from_dict
-    return case_from_dict(yaml.safe_load(run.attrs["case_yaml"]))
+    """The solver case a front run (its dataset) ran (solver.front.recorded_case)."""
+    from solver.front import recorded_case
+    return recorded_case(run)
 
 
 def reference(run):

@@ -1,8 +1,11 @@
 """Metrics over successive windows of one front run: when the start's transient ends and whether
 the front stays settled (best on runs with steady.stop: false and a long max_time).
 
-For each window [t0, t0 + length], t0 from --from (seconds, or ``steady``: the steady detection
-of solver/steady.py replayed on the run's probe series) in steps of --stride, it prints the
+With --late T0 T1 it first compares the metrics over the averaging window that the steady
+detection (solver/steady.py, replayed on the run's probe series) picks with those over
+[T0, T1], each with its se, and says which agree within 2 se of their difference. Then, for
+each window [t0, t0 + length], t0 from --from (seconds, or ``steady``: the detected window's
+start) in steps of --stride, it prints the
 study's metrics over the window (study.metrics.case_metrics against lubrication theory, the
 probe series averaged over the window as a run averages its steady window), the uniform
 depth's deviation from its mean over all windows [% h_n], the enclosed-area drift, the toe's
@@ -13,7 +16,7 @@ drift within 1 %, toe within 1 dp) and the toe's hold-out: the share of 2 s wind
 every 0.1 s, whose mean toe lies beyond 1 dp of its mean.
 
     python -m benchmarks.window_metrics RUN.nc [RUN.nc ...] [--length 1 --stride 0.5 --from 1]
-    python -m benchmarks.window_metrics RUN.nc --length 2 --stride 2 --from steady
+    python -m benchmarks.window_metrics RUN.nc --length 2 --stride 2 --from steady --late 10 14
     python -m benchmarks.window_metrics --quick [--set KEY=VALUE]    (runs a coarse front first)
 """
 from __future__ import annotations
@@ -30,7 +33,8 @@ QUICK_RUN = ["dp=0.004", "steady.max_time=3.0", "steady.stop=false"]
 
 
 def window_run(run: xr.Dataset, t0: float, t1: float) -> xr.Dataset:
-    """The run with its window means and front velocity taken over [t0, t1]."""
+    """The run with its averaging window [t0, t1] (its means, its front velocity over the
+    window's last second) and no hold-out: what the metrics read."""
     from solver import steady
     t = run.time.values
     win = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
@@ -39,23 +43,43 @@ def window_run(run: xr.Dataset, t0: float, t1: float) -> xr.Dataset:
     for k in ("surface_elevation", "velocity_star", "uniform_depth"):
         out[f"mean_{k}"] = avg[k]
     out["front_velocity"] = ((), steady.front_velocity_fit(t[win], run.toe_position.values[win])[0])
-    out = out.isel(time=win)  # zeta_f's standard error from this window's toe
-    out.attrs["status"] = "completed"
+    out.attrs.update(status="completed", window_start_s=float(t[win][0]), window_end_s=float(t[win][-1]),
+                     holdout_start_s=math.nan, holdout_end_s=math.nan)
     return out
 
 
-def replay(run: xr.Dataset) -> tuple[float, list]:
-    """(start of the first verified averaging window, withdrawn detections) of the current
-    steady detection on the run's probe series."""
-    from solver.steady import SteadyTracker
-    case = common.run_case(run)
-    t = run.time.values
-    front, depth, stations = run.front_equivalent.values, run.uniform_depth.values, run.station_front.values
-    tr = SteadyTracker(case.criteria(), case.belt.speed, case.h_n, case.steady.average)
-    for k in range(2, t.size):
-        if tr.update(t[:k + 1], front[:k + 1], depth[:k + 1], stations[:k + 1]) == "steady":
-            return tr.t_steady, [a for a, _ in tr.rejected]
-    return math.nan, [a for a, _ in tr.rejected]
+def replay(run: xr.Dataset, sets=()) -> tuple[float, float]:
+    """(start, end) of the averaging window the steady detection (solver/steady.py, the run's own
+    steady keys with ``sets`` applied, KEY=VALUE) finds on the run's probe series; NaN, NaN where
+    it finds none."""
+    import yaml
+
+    from solver.front import recorded_case, replay as replay_detection
+    found = replay_detection(run, recorded_case(run, {k: yaml.safe_load(v) for k, v in
+                                                      (s.split("=", 1) for s in sets)}))
+    return found.averaging if found is not None else (math.nan, math.nan)
+
+
+METRICS = ("zeta_f", "zeta_h", "zeta_fs")
+
+
+def against_late(run: xr.Dataset, window: tuple[float, float], late: tuple[float, float]) -> list[list[str]]:
+    """Each metric over ``window`` and over ``late`` (each +- 2 se) and whether they agree within
+    2 se of their difference."""
+    from study.metrics import case_metrics
+    ref = common.reference(run)
+    a = case_metrics(window_run(run, *window), ref, common.X_STAR_RANGE)
+    b = case_metrics(window_run(run, *late), ref, common.X_STAR_RANGE)
+    rows = []
+    names = [(k, a[k], a[f"{k}_se"], b[k], b[f"{k}_se"]) for k in METRICS]
+    names += [(f"zeta_u {s:g}", a.zeta_u.values[j], a.zeta_u_se.values[j], b.zeta_u.values[j], b.zeta_u_se.values[j])
+              for j, s in enumerate(a.station.values)]
+    for name, va, ea, vb, eb in names:
+        va, ea, vb, eb = (float(v) for v in (va, ea, vb, eb))
+        se = math.hypot(ea, eb)
+        rows.append([name, f"{100 * va:.3f} ± {200 * ea:.3f}", f"{100 * vb:.3f} ± {200 * eb:.3f}",
+                     f"{100 * (vb - va):+.3f} ± {200 * se:.3f}", "yes" if abs(vb - va) <= 2 * se else "no"])
+    return rows
 
 
 def in_window(t: np.ndarray, t0: float, t1: float) -> np.ndarray:
@@ -101,16 +125,23 @@ def sliding_toe(run: xr.Dataset, start: float, window: float = 2.0, step: float 
     return float(np.mean(np.array(devs) > 1.0)), float(max(devs)), len(devs)
 
 
-def report(path: Path, length: float, stride: float, start: str) -> str:
+def report(path: Path, length: float, stride: float, start: str, late: tuple[float, float] | None,
+           sets=()) -> str:
     with xr.open_dataset(path) as ds:
         run = ds.load()
     a = run.attrs
-    t_det, withdrawn = replay(run)
-    t0 = (t_det if np.isfinite(t_det) else 2.0) if start == "steady" else float(start)
+    w0, w1 = replay(run, sets)
+    t0 = (w0 if np.isfinite(w0) else 2.0) if start == "steady" else float(start)
     print(f"\n{path.name}: {a.get('shifting', '?')}, dp = {float(a['dp']) * 1e3:g} mm, Ch = {a.get('ch', '?')}, "
           f"{a['status']} at {float(a['simulated_time_s']):.2f} s; steady detection replayed: "
-          + (f"window from {t_det:.2f} s" if np.isfinite(t_det) else "no verified window")
-          + (f", withdrawn at {', '.join(f'{v:.2f}' for v in withdrawn)} s" if withdrawn else ""))
+          + (f"averaging window {w0:.2f}-{w1:.2f} s" if np.isfinite(w0) else "not steady"))
+    agree = ""
+    if late is not None and np.isfinite(w0):
+        rows = against_late(run, (w0, w1), late)
+        print(f"metrics [%] over the detected window and over {late[0]:g}-{late[1]:g} s:")
+        print(common.table(["metric", "detected window (± 2 se)", f"{late[0]:g}-{late[1]:g} s (± 2 se)",
+                            "difference (± 2 se)", "within 2 se"], rows))
+        agree = f"; {sum(r[-1] == 'yes' for r in rows)} of {len(rows)} metrics agree with {late[0]:g}-{late[1]:g} s"
     rows = table(run, length, stride, t0)
     if not rows:
         print(f"no {length:g} s window from {t0:g} s")
@@ -136,7 +167,7 @@ def report(path: Path, length: float, stride: float, start: str) -> str:
     print(f"toe over {n} 2 s windows every 0.1 s: {100 * share:.1f} % beyond 1 dp of its mean, "
           f"largest {largest:.2f} dp")
     return (f"{path.name}: {len(rows)} windows of {length:g} s from {t0:.2f} s, depth within {100 * dev_depth:.2f} % "
-            f"h_n, area drift within {100 * dev_area:.2f} %, toe within {dev_toe:.2f} dp")
+            f"h_n, area drift within {100 * dev_area:.2f} %, toe within {dev_toe:.2f} dp{agree}")
 
 
 def main(argv=None) -> int:
@@ -145,13 +176,16 @@ def main(argv=None) -> int:
     ap.add_argument("--length", type=float, default=1.0, help="window length [s]")
     ap.add_argument("--stride", type=float, default=0.5, help="window start step [s]")
     ap.add_argument("--from", dest="start", default="1.0", help="first window start [s], or 'steady'")
+    ap.add_argument("--late", type=float, nargs=2, metavar=("T0", "T1"),
+                    help="compare the metrics over the detected window with those over [T0, T1]")
     a = common.parse(ap, argv, {"length": 0.5, "stride": 0.5})
     runs = a.runs
     if not runs:
         if not a.quick:
             ap.error("give front runs, or --quick to run a coarse one first")
         runs = [common.front(common.EXAMPLES / "conveyor_fast.yaml", QUICK_RUN + a.sets, a.out / "quick.nc", a.threads)]
-    common.summary("; ".join(report(p, a.length, a.stride, a.start) for p in runs))
+    common.summary("; ".join(report(p, a.length, a.stride, a.start, a.late, a.sets if a.runs else ())
+                             for p in runs))
     return 0
 
 

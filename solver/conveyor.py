@@ -46,15 +46,11 @@ class Probes:
 
 @dataclass
 class Steady:
-    window: float = 1.0  # s: trailing window the drift tolerances apply to
-    front_velocity: float = 0.01  # drift of the equivalent front and each station's / (u_b window)
-    depth: float = 0.005  # uniform-depth change over the window / h_n
-    average: float = 2.0  # s: averaging window once steady
+    average: float = 3.0  # W [s]: the averaging window and its hold-out window, each (solver/steady.py)
+    fraction: float = 5.0e-4  # a drift below this fraction of a quantity's value passes however small its se
     max_time: float = 30.0  # s: give up (status not_steady) after this
-    min_time: float = 4.0  # s after the end of the belt ramp before steadiness counts: the start's
-    # transient, which the detection's signals do not see (measured to end by 3-3.5 s at dp = 0.5
-    # and 1 mm and by 5-6 s at dp = 1.5-2.25 mm: docs/conveyor.md)
-    stop: bool = True  # false: run to max_time and average its final window (fixed end time)
+    min_time: float = 0.0  # s after the end of the belt ramp before the averaging window may start
+    stop: bool = True  # false: run to max_time; the window pair is the final 2W (fixed end time)
 
 
 @dataclass
@@ -158,8 +154,7 @@ class ConveyorCase(YamlData):
 
     def criteria(self) -> SteadyCriteria:
         s = self.steady
-        return SteadyCriteria(window=s.window, front_velocity=s.front_velocity, depth=s.depth,
-                              min_time=self.ramp_end + s.min_time, dp=self.dp)
+        return SteadyCriteria(window=s.average, fraction=s.fraction, min_time=self.ramp_end + s.min_time)
 
 
 # flat numerics keys of an older case layout: where each lives now
@@ -219,9 +214,11 @@ def case_from_dict(data) -> ConveyorCase:
     if not isinstance(data, dict):
         raise SceneError(f"case: expected a mapping, got {data!r}")
     steady = data.get("steady")
-    if isinstance(steady, dict) and "velocity" in steady:
-        raise SceneError("case.steady.velocity: no longer a key; the steady detection holds each station's "
-                         "area to steady.front_velocity (docs/conveyor.md)")
+    gone = sorted(set(steady) & {"velocity", "window", "front_velocity", "depth"}) if isinstance(steady, dict) else []
+    if gone:
+        raise SceneError(f"case.steady.{gone[0]}: no longer a key; a run is steady when every reported "
+                         "quantity's drift is within its sampling error (steady.average sets the window, "
+                         "steady.fraction the drift that passes regardless; docs/conveyor.md)")
     case = parse_into(ConveyorCase, resolve_scheme(data), "case")
     validate_case(case)
     return case
@@ -279,15 +276,14 @@ def validate_case(c: ConveyorCase) -> None:
             f"case.fluid_length: {c.fluid_length:g} h_n leaves no room for probes up to "
             f"x* = {p.x_star_max:g} (need fluid_length >= x_star_max + 2)")
     s = c.steady
-    for key in ("window", "front_velocity", "depth", "average", "max_time"):
+    for key in ("average", "max_time"):
         positive(getattr(s, key), f"case.steady.{key}")
     if s.min_time < 0:
         raise SceneError("case.steady.min_time: must be >= 0")
-    if s.window < 5 * p.interval:
-        raise SceneError("case.steady.window: must hold at least 5 probe intervals")
-    if s.average < 1.0:
-        raise SceneError("case.steady.average: must be at least 1 s (the front velocity is "
-                         "averaged over one second)")
+    if not 0.0 <= s.fraction < 0.1:
+        raise SceneError(f"case.steady.fraction: {s.fraction!r} is not in [0, 0.1)")
+    if s.average < 10 * p.interval:
+        raise SceneError("case.steady.average: must hold at least 10 probe intervals")
     scene_from_dict(build_scene_dict(c))  # scene-level checks (budget, keys, geometry)
 
 

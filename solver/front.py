@@ -2,6 +2,7 @@
 volume-consistency guard, checkpoints, and one NetCDF per run."""
 from __future__ import annotations
 
+import bisect
 import hashlib
 import math
 import os
@@ -94,7 +95,8 @@ class FrontMonitor:
         self.x_star = np.round(np.arange(0.0, p.x_star_max + 0.5 * p.x_star_step, p.x_star_step), 10)
         self.z_star = np.round(np.arange(0.0, p.z_star_max + 0.5 * p.z_star_step, p.z_star_step), 10)
         self.stations = np.asarray(p.stations, dtype=float)
-        self.tracker = steady.SteadyTracker(case.criteria(), case.belt.speed, case.h_n, case.steady.average)
+        self.x_detect = self.x_star <= p.uniform_zone[1] + 1e-9  # the surface the detector watches
+        self.detector = steady.SteadyDetector(case.criteria(), case.belt.speed)
         self.state = "transient"
         self.t: list[float] = []
         self.series = {k: [] for k in SERIES}
@@ -110,8 +112,23 @@ class FrontMonitor:
 
     @property
     def t_steady(self) -> float:
-        """Time steady state was detected (NaN: not, or withdrawn)."""
-        return self.tracker.t_steady
+        """Start of the steady averaging window (NaN: not steady yet)."""
+        return self.detector.t_steady
+
+    def record(self, start: float = -math.inf) -> steady.Record:
+        """The detector's quantities from the probe samples at or after ``start``."""
+        i = bisect.bisect_left(self.t, start - 1e-9)
+        hn, n = self.case.h_n, len(self.t) - i
+        return steady.Record(np.asarray(self.t[i:], dtype=float),
+                             np.asarray(self.series["toe"][i:], dtype=float),
+                             np.asarray(self.series["uniform_depth"][i:], dtype=float) / hn,
+                             np.asarray(self.surface[i:], dtype=float).reshape(n, -1)[:, self.x_detect] / hn,
+                             np.asarray(self.velocity[i:], dtype=float).reshape(n, self.stations.size, -1))
+
+    def final_judgement(self) -> steady.Judgement:
+        """The window pair ending at the last sample."""
+        d = self.detector
+        return steady.judge(self.record(), float(self.t[-1]), d.crit, d.u_b)
 
     # ---- one sample ---------------------------------------------------------------
     def sample(self, sim: Simulation) -> dict:
@@ -170,38 +187,11 @@ class FrontMonitor:
                 "surface": surface, "velocity": u_star}
 
     def why_not_steady(self) -> str:
-        """Which signals fail their tolerance, by how much, over the trailing span (of
-        steady.SPANS) closest to passing, and which detections were withdrawn."""
+        """Which quantities drift beyond their allowance over the final window pair."""
         t = np.asarray(self.t)
-        if t.size < 3:
-            return "too few probe samples"
-        # the trailing span (of those detection tries) that came closest to passing
-        crit = self.tracker.crit
-        best = None
-        for k in steady.SPANS:
-            span = k * crit.window
-            if k > 1 and t[-1] - span < max(crit.min_time, t[0]) - 1e-9:
-                break
-            r = steady.assess(t, self.series["front_equivalent"], self.series["uniform_depth"],
-                              self.station_fronts(), crit, self.case.belt.speed, self.case.h_n,
-                              t_start=t[-1] - span)["ratio"]
-            worst = max((v if np.isfinite(v) else math.inf) for v in r.values())
-            if best is None or worst < best[0]:
-                best = (worst, span, r)
-        _, span, r = best
-        names = {"front": "front position", "depth": "uniform depth", "station": "station front"}
-        failing = [f"{names[k]} {v:.1f}x" for k, v in r.items() if not (np.isfinite(v) and v <= 1.0)]
-        text = (f"over the final {span:g} s, drift bound / tolerance: " + ", ".join(failing)) if failing else \
-            f"the final {span:g} s meet the tolerances"
-        t_s = self.tracker.t_steady
-        if np.isfinite(t_s):
-            text += (f"; steady state detected at {t_s:.2f} s, but its averaging window ({t[-1] - t_s:.2f} s "
-                     "by max_time) had not yet met the tolerances")
-        withdrawn = [a for a, _ in self.tracker.rejected]
-        if withdrawn:
-            text += (f"; detections at {', '.join(f'{v:.2f}' for v in withdrawn)} s withdrawn "
-                     "(their averaging windows drifted or stayed too noisy)")
-        return text
+        if t.size < 8 or t[-1] - t[0] < 2.0 * self.detector.crit.window:
+            return "the record is shorter than two averaging windows"
+        return self.final_judgement().describe()
 
     def station_fronts(self) -> np.ndarray:
         """Equivalent front from each station's lab-fixed anchor over time, (time, station)."""
@@ -229,8 +219,9 @@ class FrontMonitor:
             return ("diverged", f"t = {sim.t:.6g} s: enclosed area differs from the mass-implied "
                     f"area by {100 * drift:+.1f} % (max_area_drift = {self.case.max_area_drift:g})")
         if self.state != "steady":
-            self.state = self.tracker.update(self.t, self.series["front_equivalent"],
-                                             self.series["uniform_depth"], self.station_fronts())
+            w = self.detector.crit.window
+            start = -math.inf if math.isnan(self.detector.t_first) else sim.t - 2.0 * w - self.interval
+            self.state = "steady" if self.detector.update(self.record(start)) else "transient"
             if self.state == "steady" and self.case.steady.stop:
                 return ("completed", "")
         return None
@@ -305,44 +296,39 @@ class FrontMonitor:
         ds["film_slip"] = (("time",), slip, {
             "units": "1",
             "long_name": f"u* at the bed of the fitted profile at x* = {self.stations[far]:g} (0: no slip)"})
-        # the averaging window: with steady.stop, the window after detection (steady.average,
-        # or longer where the tracker extended a noisy window), steady when the tracker
-        # verified it; otherwise (fixed end time, or no steady state) the final window
-        # of the same length, steady only when steady state was detected before it starts and
-        # the window itself meets the tolerances; a window that is not steady is flagged
-        # (attrs steady = 0, averaging) so that nothing passes for a steady result
-        final = t[-1] - c.steady.average if t.size else np.nan
-        end = t[-1] if t.size else np.nan
-        if c.steady.stop:
-            steady_found = self.state == "steady"
-            start = self.t_steady if steady_found else final
-            end = self.tracker.t_end if steady_found else end
-        else:
-            start = final
-            steady_found = bool(np.isfinite(self.t_steady) and self.t_steady <= final + 1e-9
-                                and self.tracker.verify(t, self.series["front_equivalent"],
-                                                        self.series["uniform_depth"],
-                                                        self.station_fronts(), final))
-        ds.attrs["steady_state_time_s"] = float(self.t_steady) if steady_found else math.nan
+        # the averaging window A and its hold-out B: with steady.stop, the first steady pair;
+        # otherwise (fixed end time, or no steady pair by max_time) the pair ending at the last
+        # sample, steady only if it passes; a record shorter than two windows averages its final
+        # window, not steady, without a hold-out. Nothing that is not steady passes for steady.
+        w = self.detector.crit.window
+        j = None
+        if c.steady.stop and self.detector.found is not None:
+            j = self.detector.found
+        elif t.size >= 8 and t[-1] - t[0] >= 2.0 * w - 1e-9:
+            j = self.final_judgement()
+        steady_found = j is not None and j.steady
+        nan = math.nan
+        (a0, a1), (b0, b1) = (j.averaging, j.holdout) if j is not None else \
+            (((t[-1] - w, t[-1]) if t.size else (nan, nan)), (nan, nan))
+        ds.attrs["steady_state_time_s"] = float(a0) if steady_found else nan
         ds.attrs["steady"] = int(steady_found)
-        ds.attrs["steady_withdrawn_s"] = [float(a) for a, _ in self.tracker.rejected] or ""
         ds.attrs["averaging"] = "steady window" if steady_found else "final window, NOT steady"
-        if t.size and t[-1] - t[0] >= c.steady.average - 1e-9:
-            win = (t >= start - 1e-9) & (t <= end + 1e-9)
+        ds.attrs["window_start_s"], ds.attrs["window_end_s"] = float(a0), float(a1)
+        ds.attrs["holdout_start_s"], ds.attrs["holdout_end_s"] = float(b0), float(b1)
+        ds.attrs["steady_judgement"] = j.describe() if j is not None else "record shorter than two windows"
+        for q, r in (j.ratios.items() if j is not None else ()):
+            ds.attrs[f"drift_ratio_{q.replace(' ', '_')}"] = float(r)
+        if t.size and t[-1] - t[0] >= w - 1e-9:
+            win = (t >= a0 - 1e-9) & (t <= a1 + 1e-9)
             tw = t[win]
             avg = ds.isel(time=win).mean("time")
             for k in ("surface_elevation", "velocity_star", "uniform_depth", "number_density", "area_drift"):
                 long_name = ds.attrs["averaging"] + " mean of " + ds[k].attrs["long_name"]
                 ds[f"mean_{k}"] = avg[k].assign_attrs(ds[k].attrs, long_name=long_name)
-            d = steady.drifts(tw, ds.toe_position.values[win], ds.uniform_depth.values[win],
-                              self.station_means()[win], tw[-1] - tw[0])
             ds["front_velocity"] = ((), steady.front_velocity_fit(tw, ds.toe_position.values[win])[0],
                                     {"units": "m s-1",
                                      "long_name": "toe velocity over the last second of the window, lab frame"})
             ds.attrs["average_window_s"] = float(tw[-1] - tw[0])
-            ds.attrs["window_front_velocity_over_ub"] = float(d["front_velocity"] / c.belt.speed)
-            ds.attrs["window_depth_change_over_hn"] = float(d["depth_change"] / hn)
-            ds.attrs["window_velocity_change"] = float(d["velocity_change"])
         return ds
 
 
@@ -503,3 +489,44 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     })
     return ds
 
+
+
+def record_of(ds: xr.Dataset, case: ConveyorCase) -> steady.Record:
+    """The detector's quantities (``FrontMonitor.record``) from a run's probe series."""
+    hn = case.h_n
+    x_detect = ds["x_star"].values <= case.probes.uniform_zone[1] + 1e-9
+    return steady.Record(ds["time"].values, ds["toe_position"].values, ds["uniform_depth"].values / hn,
+                         ds["surface_elevation"].values[:, x_detect] / hn, ds["velocity_star"].values)
+
+
+def recorded_case(ds: xr.Dataset, sets: dict | None = None) -> ConveyorCase:
+    """The case a run recorded (``case_yaml``), with ``sets`` ({dotted key: value}) applied; a
+    record's steady keys that the detection no longer reads are left out, so that an older run
+    replays with today's detection."""
+    import yaml
+    from dataclasses import fields
+    from .conveyor import Steady, case_from_dict
+    d = yaml.safe_load(ds.attrs["case_yaml"])
+    known = {f.name for f in fields(Steady)}
+    d["steady"] = {k: v for k, v in (d.get("steady") or {}).items() if k in known}
+    for key, value in (sets or {}).items():
+        node = d
+        *path, last = key.split(".")
+        for k in path:
+            node = node.setdefault(k, {})
+        node[last] = value
+    return case_from_dict(d)
+
+
+def replay(ds: xr.Dataset, case: ConveyorCase | None = None, crit: steady.SteadyCriteria | None = None):
+    """The first steady window pair the detector finds on a run's probe series (None: none),
+    with the criteria of the run's own case unless ``crit`` is given."""
+    if case is None:
+        case = recorded_case(ds)
+    rec = record_of(ds, case)
+    det = steady.SteadyDetector(crit or case.criteria(), case.belt.speed)
+    w = det.crit.window
+    for k in range(rec.t.size):
+        if det.update(rec.span(rec.t[k] - 2.0 * w - case.probes.interval if k else -math.inf, rec.t[k])):
+            break
+    return det.found

@@ -1,91 +1,122 @@
-"""Steady-state detection on probe time series (pure functions).
+"""Steady state from the probe series: a run is steady once every quantity it reports holds
+still to within its own sampling error, or within a small fraction of its value (pure functions).
 
-Over the trailing window [t_end - window, t_end] each signal y(t) is fitted by a straight
-line (least squares). Its drift over the window, |slope| * window, must be below the
-signal's tolerance with confidence: the upper bound |slope| + Z * se(slope) of the drift
-rate, times the window, must not exceed it. se(slope) comes from the fit's residuals,
-widened for their correlation from sample to sample (effective sample count
-n (1 - r1) / (1 + r1), r1 the lag-1 autocorrelation of the residuals, r1 >= 0). So a trend
-is weighed against the signal's own sampling noise: noise alone lengthens the time to
-detection. (A lag-1 estimate understates slow wander: with a 3 s correlation time, a drift
-of 1.25 times the tolerance passed in 3 of 40 synthetic series; twice it in none.)
+Quantities, each a set of components sampled every probe interval:
 
-Verification: once detected at t_s, the averaging window [t_s, t_s + average] must itself
-meet the tolerances (1 se: the detection was already confident). A window that fails there
-without a confident drift (every signal's lower bound |slope| - 2 se within its tolerance)
-is too noisy to judge, not drifting: it is extended, and the longer window must then pass
-at 2 se, up to the longest detection span (SPANS[-1] windows). A confident drift at the
-nominal end, or a window that reaches that length without passing, withdraws the detection.
+  toe      the toe's distance from the upstream wall (zeta_f)         1 component
+  depth    the uniform depth h_u / h_n (zeta_h)                      1 component
+  surface  the free surface z / h_n at each x* in [0, x_max] (zeta_fs)
+  station  u* at each z* of one station (zeta_u), one quantity a station
 
-Signals: the equivalent front (front), the uniform depth (depth) and one equivalent front
-from each station (station): x_s + (fluid area downstream of x_s) / h_n, x_s fixed in the lab
-frame. A steady front holds every one of them; together they hold the areas between the
-stations, a coarse measure of the front's shape (the tip's shape within the nearest station
-they do not resolve: the case's min_time leaves out its relaxation after the start). A
-station's depth-mean velocity is the time derivative of that area, q / h: the same balance,
-with the particles' flux noise undamped.
+A window pair is an averaging window A = [t - 2W, t - W] and a hold-out window B = [t - W, t].
+Over each window every component y_i gets a least-squares line: mean m_i with standard error
+s_i, slope b_i with standard error sb_i (residual variance, widened for the residuals' lag-1
+correlation; ``_line_fits``). Each component's two drifts, over its allowance:
 
-Tolerances (the probes of a coarse run fluctuate by a fraction of dp, so a tolerance fixed
-in h_n or u_b alone cannot be met at every dp):
-  front, station: drift <= max(front_velocity * u_b * window, NOISE_DP * dp)
-  depth:          drift <= max(depth * h_n, NOISE_DP * dp)
+  hold-out change  d_i = (m_B,i - m_A,i) / max(Z sqrt(s_A,i^2 + s_B,i^2), f |m_A,i|)
+  fitted change    e_i = b_A,i W / max(Z sb_A,i W, f |m_A,i|)
+
+Z = 2, f = steady.fraction. A quantity's ratios are R_D = rms_i d_i and R_F = rms_i e_i over
+the components measured in both windows; the pair is steady when every R is at most 1. The toe's
+fitted change is zeta_f's front velocity times W: with a fixed volume of fluid, a front that
+creeps by a fraction of the layer's length thins the layer by that fraction, which the same
+fraction of the depth bounds. The first probe time t >= min_time + 2W at which a pair is steady
+ends the run; its A is the averaging window and its B the hold-out.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numba as nb
 import numpy as np
 
-Z = 2.0  # detection: confidence multiplier on the slope's standard error
-VERIFY_Z = 1.0  # verification of an averaging window (detection already was confident)
-NOISE_DP = 0.1  # fraction of dp a surface or toe probe may drift over a window, at any dp
+Z = 2.0  # standard errors a drift may reach before it counts as real
+QUANTITIES = ("toe", "depth", "surface", "station")
 
 
 @dataclass
 class SteadyCriteria:
-    window: float = 1.0  # s
-    front_velocity: float = 0.01  # fraction of u_b
-    depth: float = 0.005  # fraction of h_n over the window
-    min_time: float = 0.0  # s: not before (e.g. the end of the belt ramp)
-    dp: float = 0.0  # m: particle spacing, for the noise floor of the tolerances
+    window: float = 3.0  # W [s]: the averaging window and the hold-out window, each
+    fraction: float = 5.0e-4  # f: a drift below f times the quantity's value passes however small its se
+    min_time: float = 0.0  # s: earliest start of the averaging window
 
 
-def trend(t: np.ndarray, y: np.ndarray) -> float:
-    """Least-squares slope dy/dt (NaN if fewer than 3 finite samples)."""
-    return trend_bound(t, y)[0]
+@dataclass
+class Record:
+    """The probe series the detector reads, over time (axis 0)."""
+    t: np.ndarray  # (n,) s
+    toe: np.ndarray  # (n,) m
+    depth: np.ndarray  # (n,) h_u / h_n
+    surface: np.ndarray  # (n, nx) z / h_n over x* in [0, x_max]
+    stations: np.ndarray  # (n, ns, nz) u*
+
+    def span(self, start: float, end: float = math.inf) -> Record:
+        """The samples from ``start`` to ``end``."""
+        i = int(np.searchsorted(self.t, start - 1e-9))
+        j = int(np.searchsorted(self.t, end + 1e-9, side="right"))
+        return Record(self.t[i:j], self.toe[i:j], self.depth[i:j], self.surface[i:j], self.stations[i:j])
 
 
-def trend_bound(t, y) -> tuple[float, float]:
-    """(slope, standard error of the slope) of the least-squares line, the error widened
-    for lag-1 correlation of the residuals; NaNs if fewer than 3 finite samples."""
-    slope, se = trend_bounds(t, np.asarray(y, dtype=float)[None, :])
-    return float(slope[0]), float(se[0])
+@dataclass
+class Judgement:
+    """One window pair: for each quantity, (R_D, R_F); steady when every one is at most 1."""
+    t_end: float
+    window: float
+    drifts: dict = field(default_factory=dict)
+
+    @property
+    def ratios(self) -> dict:
+        """Each quantity's larger drift over its allowance (NaN: not measurable)."""
+        return {q: max(d, f) if math.isfinite(d) and math.isfinite(f) else math.nan
+                for q, (d, f) in self.drifts.items()}
+
+    @property
+    def steady(self) -> bool:
+        return bool(self.drifts) and all(math.isfinite(r) and r <= 1.0 for r in self.ratios.values())
+
+    @property
+    def averaging(self) -> tuple[float, float]:
+        return self.t_end - 2.0 * self.window, self.t_end - self.window
+
+    @property
+    def holdout(self) -> tuple[float, float]:
+        return self.t_end - self.window, self.t_end
+
+    def describe(self) -> str:
+        """The quantities that drift, by how much of their allowance."""
+        bad = [f"{q} {r:.1f}x" if math.isfinite(r) else f"{q} not measurable"
+               for q, r in self.ratios.items() if not (math.isfinite(r) and r <= 1.0)]
+        a0, a1 = self.averaging
+        span = f"window {a0:.2f}-{a1:.2f} s against its hold-out to {self.t_end:.2f} s"
+        return f"{span}: drift / allowance " + ", ".join(bad) if bad else f"{span}: steady"
 
 
-def trend_bounds(t, ys, first: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """``trend_bound`` of each row of ys over the samples from index ``first`` on (times t),
-    each row over its finite samples."""
+def line_fits(t, ys) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(mean, se of the mean, slope, se of the slope) of each row of ys (times t) over its
+    finite samples (module docstring); NaN with fewer than 3, se 0 where the residuals are 0."""
     t = np.ascontiguousarray(t, dtype=float)
     ys = np.ascontiguousarray(np.atleast_2d(np.asarray(ys, dtype=float)))
-    return _line_fits(t, ys, first)
+    return _line_fits(t, ys)
 
 
 @nb.njit(cache=True)
-def _line_fits(t, ys, first):
-    """The kernel of ``trend_bounds``: per row, the least-squares slope b over its finite
-    samples (t_i, y_i), its residuals e_i, ss = sum e_i^2, r1 = sum e_i e_(i+1) / ss clipped
-    to [0, 0.95], n_eff = max(n (1 - r1) / (1 + r1), 3) and se = sqrt(ss / (n - 2) / stt * n / n_eff)
-    (0 with fewer than 4 samples or ss = 0; NaN with fewer than 3 or stt = 0)."""
+def _line_fits(t, ys):
+    """Per row: the least-squares line over its finite samples (t_i, y_i), residuals e_i,
+    ss = sum e_i^2; the lag-1 correlation r1 = sum e_i e_(i+1) / ss (at least 0) plus its
+    estimation bias (1 + 3 r1) / n, at most 0.95; n_eff = max(n (1 - r1) / (1 + r1), 3);
+    var = ss / (n - 2) * n_eff / max(n_eff - 2, 1) (the variance a line through correlated
+    samples hides); se(mean) = sqrt(var / n_eff), se(slope) = sqrt(var / stt * n / n_eff)."""
     rows = ys.shape[0]
+    mean = np.full(rows, np.nan)
+    se_mean = np.full(rows, np.nan)
     slope = np.full(rows, np.nan)
-    se = np.full(rows, np.nan)
+    se_slope = np.full(rows, np.nan)
     tt = np.empty(t.size)
     yy = np.empty(t.size)
     for r in range(rows):
         n = 0
-        for i in range(first, t.size):
+        for i in range(t.size):
             if np.isfinite(ys[r, i]):
                 tt[n] = t[i]
                 yy[n] = ys[r, i]
@@ -107,6 +138,7 @@ def _line_fits(t, ys, first):
         if stt <= 0.0:
             continue
         b = sty / stt
+        mean[r] = ym
         slope[r] = b
         ss = 0.0
         s1 = 0.0
@@ -117,13 +149,28 @@ def _line_fits(t, ys, first):
             if i > 0:
                 s1 += e * prev
             prev = e
-        if n < 4 or ss == 0.0:
-            se[r] = 0.0
+        if ss == 0.0:
+            se_mean[r] = 0.0
+            se_slope[r] = 0.0
             continue
-        r1 = min(max(s1 / ss, 0.0), 0.95)
+        r1 = max(s1 / ss, 0.0)
+        r1 = min(r1 + (1.0 + 3.0 * r1) / n, 0.95)
         n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
-        se[r] = math.sqrt(ss / (n - 2) / stt * (n / n_eff))
-    return slope, se
+        var = ss / (n - 2) * n_eff / max(n_eff - 2.0, 1.0)
+        se_mean[r] = math.sqrt(var / n_eff)
+        se_slope[r] = math.sqrt(var / stt * (n / n_eff))
+    return mean, se_mean, slope, se_slope
+
+
+def trend_bound(t, y) -> tuple[float, float]:
+    """(slope, its standard error) of the least-squares line of y(t) (``line_fits``)."""
+    _, _, b, sb = line_fits(t, np.asarray(y, dtype=float)[None, :])
+    return float(b[0]), float(sb[0])
+
+
+def trend(t, y) -> float:
+    """Least-squares slope dy/dt (NaN with fewer than 3 finite samples)."""
+    return trend_bound(t, y)[0]
 
 
 FRONT_VELOCITY_SPAN = 1.0  # s: zeta_f's toe velocity is averaged over one second (docs/scheme.md section 4)
@@ -137,152 +184,73 @@ def front_velocity_fit(t, toe) -> tuple[float, float]:
     return trend_bound(t[last], np.asarray(toe, dtype=float)[last])
 
 
-def window_mask(t: np.ndarray, t_end: float, window: float) -> np.ndarray:
-    return (t >= t_end - window - 1e-12) & (t <= t_end + 1e-12)
+def _rms(x) -> float:
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x * x))) if x.size else math.nan
 
 
-def drifts(t, toe, depth, station_u, window: float) -> dict[str, float]:
-    """Trend of each signal over the last ``window`` seconds of the samples.
-
-    Returns front velocity [m/s] (toe slope), depth change over the window [m], and the
-    largest change over the window of the station depth-mean velocities [u*]."""
-    t = np.asarray(t, dtype=float)
-    m = window_mask(t, t[-1], window)
-    su = np.asarray(station_u, dtype=float).reshape(len(t), -1)
-    return {
-        "front_velocity": trend(t[m], np.asarray(toe)[m]),
-        "depth_change": trend(t[m], np.asarray(depth)[m]) * window,
-        "velocity_change": max(abs(trend(t[m], su[m, j]) * window) for j in range(su.shape[1])),
-    }
-
-
-def tolerances(crit: SteadyCriteria, u_b: float, h_n: float) -> dict[str, float]:
-    """Allowed drift over one window of each signal (see the module docstring)."""
-    floor = NOISE_DP * crit.dp
-    front = max(crit.front_velocity * u_b * crit.window, floor)
-    return {"front": front, "depth": max(crit.depth * h_n, floor), "station": front}
+def _drift_ratios(ta, ya, tb, yb, window: float, fraction: float) -> tuple[float, float]:
+    """(R_D, R_F) of a quantity whose components are the columns of ya (times ta, window A) and
+    yb (window B), over the components measured in both windows (module docstring)."""
+    ma, sa, ba, sba = line_fits(ta, ya.T)
+    mb, sb, _, _ = line_fits(tb, yb.T)
+    ok = np.isfinite(ma) & np.isfinite(mb) & np.isfinite(sa) & np.isfinite(sb) & np.isfinite(ba)
+    if not ok.any():
+        return math.nan, math.nan
+    floor = fraction * np.abs(ma[ok])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r_d = (mb[ok] - ma[ok]) / np.maximum(Z * np.hypot(sa[ok], sb[ok]), floor)
+        r_f = ba[ok] * window / np.maximum(Z * sba[ok] * window, floor)
+    r_d = np.where((mb[ok] == ma[ok]), 0.0, r_d)  # 0 / 0: no drift
+    r_f = np.where(ba[ok] == 0.0, 0.0, r_f)
+    return float(np.sqrt(np.mean(r_d * r_d))), float(np.sqrt(np.mean(r_f * r_f)))
 
 
-def assess(t, front, depth, stations, crit: SteadyCriteria, u_b: float, h_n: float,
-           t_start: float | None = None, z: float = Z) -> dict:
-    """Confident drift bounds against tolerances over [t_start, t_end] (default: the
-    trailing ``crit.window``). Drift bounds are scaled to the span of ``crit.window``, so a
-    longer span (an averaging window) is judged by the same rates.
-
-    Returns {"steady": bool, "ratio": {signal: upper bound / tolerance} (ratio <= 1
-    passes), "lower": {signal: (|slope| - Z se) * window / tolerance} (> 1: a confident
-    drift beyond the tolerance)}."""
-    t, ys, names = _signals(t, front, depth, stations)
-    start = t[-1] - crit.window if t_start is None else t_start
-    return _assess(t, ys, names, start, crit, tolerances(crit, u_b, h_n), z)
-
-
-def _signals(t, front, depth, stations) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """The times (ascending) and the signals as rows: front, depth, each station's front."""
-    t = np.asarray(t, dtype=float)
-    sf = np.asarray(stations, dtype=float).reshape(len(t), -1)
-    ys = np.vstack([np.asarray(front, dtype=float), np.asarray(depth, dtype=float), sf.T])
-    return t, ys, ["front", "depth"] + ["station"] * sf.shape[1]
+def judge(rec: Record, t_end: float, crit: SteadyCriteria, u_b: float) -> Judgement:
+    """The window pair ending at ``t_end``: A = [t_end - 2W, t_end - W], B = [t_end - W, t_end]."""
+    w, f = crit.window, crit.fraction
+    out = Judgement(t_end, w)
+    t = rec.t
+    in_a = (t >= t_end - 2.0 * w - 1e-9) & (t <= t_end - w + 1e-9)
+    in_b = (t > t_end - w + 1e-9) & (t <= t_end + 1e-9)
+    if in_a.sum() < 8 or in_b.sum() < 4:
+        return out
+    ta, tb = t[in_a], t[in_b]
+    out.drifts["toe"] = _drift_ratios(ta, rec.toe[in_a, None], tb, rec.toe[in_b, None], w, f)
+    out.drifts["depth"] = _drift_ratios(ta, rec.depth[in_a, None], tb, rec.depth[in_b, None], w, f)
+    out.drifts["surface"] = _drift_ratios(ta, rec.surface[in_a], tb, rec.surface[in_b], w, f)
+    for k in range(rec.stations.shape[1]):
+        out.drifts[f"station {k + 1}"] = _drift_ratios(ta, rec.stations[in_a, k], tb, rec.stations[in_b, k], w, f)
+    return out
 
 
-def _assess(t, ys, names, start, crit, tol, z) -> dict:
-    """``assess`` over the samples from ``start`` on, of the rows of ``_signals``."""
-    slopes, ses = trend_bounds(t, ys, int(np.searchsorted(t, start - 1e-12)))
-    ratio = {"front": 0.0, "depth": 0.0, "station": 0.0}
-    lower = dict(ratio)
-    for name, s, se in zip(names, slopes.tolist(), ses.tolist()):
-        if math.isnan(s) or math.isnan(ratio[name]):
-            ratio[name] = lower[name] = math.nan
-            continue
-        ratio[name] = max(ratio[name], (abs(s) + z * se) * crit.window / tol[name])
-        lower[name] = max(lower[name], (abs(s) - Z * se) * crit.window / tol[name])
-    ok = all(v <= 1.0 for v in ratio.values())  # False for NaN
-    return {"steady": bool(ok), "ratio": ratio, "lower": lower}
+class SteadyDetector:
+    """Judges the window pair ending at each probe time from ``crit.min_time + 2W`` on; the
+    first steady pair is the run's (``found``)."""
 
-
-# trailing spans tried, in windows: a longer span resolves a noisier trend. Every whole number
-# of windows up to 8, so that a noisy signal is declared at the first span long enough to
-# resolve its noise (not at the next power of two); the spans are nested, each containing the
-# shorter ones, so their fits are strongly correlated and trying all of them raises the
-# chance that a drift beyond its tolerance passes only a little (tests/test_steady.py)
-SPANS = tuple(range(1, 9))
-
-
-def is_steady(t, front, depth, stations, crit: SteadyCriteria, u_b: float, h_n: float) -> bool:
-    """True when a trailing span of SPANS windows, after ``crit.min_time``, meets every
-    tolerance with confidence. A noisy signal needs a longer span to show that its drift
-    is small; a real drift fails on every span."""
-    t = np.asarray(t, dtype=float)
-    if t.size < 3:
-        return False
-    first = max(crit.min_time, t[0])
-    t, ys, names = _signals(t, front, depth, stations)
-    tol = tolerances(crit, u_b, h_n)
-    for k in SPANS:
-        start = t[-1] - k * crit.window
-        if start < first - 1e-12:
-            break
-        if _assess(t, ys, names, start, crit, tol, Z)["steady"]:
-            return True
-    return False
-
-
-class SteadyTracker:
-    """Steady detection followed by verification of the averaging window.
-
-    ``update`` takes the probe series so far. Once ``is_steady`` fires at t_s the run
-    averages over [t_s, t_s + average]; when that window is complete it must itself meet
-    the tolerances (``judge_window``). A window too noisy to judge is extended (``t_end``
-    moves on); a drifting one is withdrawn (recorded in ``rejected``) and detection starts
-    again. States: "transient", "averaging", "steady". A steady window is [t_steady, t_end].
-    """
-
-    def __init__(self, crit: SteadyCriteria, u_b: float, h_n: float, average: float):
-        self.crit, self.u_b, self.h_n, self.average = crit, u_b, h_n, average
-        self.t_steady = math.nan
-        self.t_end = math.nan  # end of the verified averaging window
-        self.rejected: list[tuple[float, float]] = []  # (detected at, withdrawn at)
+    def __init__(self, crit: SteadyCriteria, u_b: float):
+        self.crit, self.u_b = crit, u_b
+        self.found: Judgement | None = None
+        self.t_first = math.nan  # the record's first sample time
 
     @property
-    def max_average(self) -> float:
-        """The longest an averaging window may be extended to."""
-        return max(self.average, SPANS[-1] * self.crit.window)
+    def t_steady(self) -> float:
+        """Start of the averaging window (NaN: not steady yet)."""
+        return self.found.averaging[0] if self.found is not None else math.nan
 
-    def update(self, t, front, depth, stations) -> str:
-        t_end = float(np.asarray(t)[-1])
-        if math.isnan(self.t_steady):
-            if is_steady(t, front, depth, stations, self.crit, self.u_b, self.h_n):
-                self.t_steady = t_end
-                return "averaging"
-            return "transient"
-        if t_end < self.t_steady + self.average - 1e-9:
-            return "averaging"
-        verdict = self.judge_window(t, front, depth, stations, self.t_steady)
-        if verdict == "steady":
-            self.t_end = t_end
-            return "steady"
-        if verdict != "drift" and t_end < self.t_steady + self.max_average - 1e-9:
-            return "averaging"  # too noisy to judge yet: the window is extended
-        self.rejected.append((self.t_steady, t_end))
-        self.t_steady = math.nan
-        return "transient"
+    @property
+    def earliest_end(self) -> float:
+        """The first probe time a pair may end at."""
+        return max(self.crit.min_time, self.t_first) + 2.0 * self.crit.window
 
-    def judge_window(self, t, front, depth, stations, t_start: float) -> str:
-        """The averaging window from t_start to the last sample: "steady" when it meets the
-        tolerances (the nominal window at 1 se, an extended one at 2 se); otherwise, at the
-        nominal end, "drift" when a signal's drift exceeds its tolerance with confidence
-        (lower bound |slope| - 2 se) and "noisy" when none does; past it, "extended"."""
-        t = np.asarray(t, dtype=float)
-        extended = t.size > 1 and t[-2] >= t_start + self.average - 1e-9  # past its nominal end
-        r = assess(t, front, depth, stations, self.crit, self.u_b, self.h_n, t_start=t_start,
-                   z=Z if extended else VERIFY_Z)
-        if r["steady"]:
-            return "steady"
-        if extended:
-            return "extended"
-        return "noisy" if all(np.isfinite(v) and v <= 1.0 for v in r["lower"].values()) else "drift"
-
-    def verify(self, t, front, depth, stations, t_start: float) -> bool:
-        """Whether the samples from t_start on meet the tolerances (a fixed-end window, 1 se)."""
-        return assess(t, front, depth, stations, self.crit, self.u_b, self.h_n, t_start=t_start,
-                      z=VERIFY_Z)["steady"]
+    def update(self, rec: Record) -> bool:
+        """Judge the pair ending at the record's last sample (after the first call, the record
+        needs to hold only the last 2W); True once a pair has been steady."""
+        if rec.t.size and math.isnan(self.t_first):
+            self.t_first = float(rec.t[0])
+        if self.found is None and rec.t.size and rec.t[-1] >= self.earliest_end - 1e-9:
+            j = judge(rec, float(rec.t[-1]), self.crit, self.u_b)
+            if j.steady:
+                self.found = j
+        return self.found is not None

@@ -113,19 +113,17 @@ def test_start_falls_back_to_h_n_when_the_film_stops():
 
 def test_fast_example_is_the_paper_case_with_the_shipped_scheme():
     """examples/conveyor_fast.yaml differs from conveyor.yaml (scheme: spec) only in its name,
-    shifting method, scheme (the default, surge) and steady window, and builds a valid scene with
-    the surge preset's numerics."""
+    shifting method, scheme (the default, surge) and steady.max_time, and builds a valid scene
+    with the surge preset's numerics."""
     with open(EXAMPLES / "conveyor.yaml") as fh:
         paper_d = yaml.safe_load(fh)
     with open(EXAMPLES / "conveyor_fast.yaml") as fh:
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
     assert changed == {"name", "shifting", "scheme", "steady"}
-    own = ("max_time", "average", "min_time")
-    assert {k: v for k, v in fast_d["steady"].items() if k not in own} == \
-        {k: v for k, v in paper_d["steady"].items() if k not in own}
-    assert fast_d["steady"]["average"] == 1.0
-    assert fast_d["steady"]["min_time"] == 2.0 and fast_d["dp"] <= 1.0e-3
+    assert {k: v for k, v in fast_d["steady"].items() if k != "max_time"} == \
+        {k: v for k, v in paper_d["steady"].items() if k != "max_time"}
+    assert fast_d["dp"] <= 1.0e-3
     fast = case_from_dict(fast_d)
     n = fast.numerics
     assert (fast.scheme, fast.shifting, n.viscous_correction, fast.start_velocity) == \
@@ -186,8 +184,11 @@ def test_case_errors_name_the_key():
         paper(shifting="magic")
     with pytest.raises(SceneError, match="numerics.shifting.min_speed"):
         paper(numerics={"shifting": {"min_speed": -0.5}})
-    with pytest.raises(SceneError, match="case.steady.velocity: no longer a key.*front_velocity"):
-        paper(steady={"window": 1.0, "velocity": 0.02})
+    for gone in ("velocity", "window", "front_velocity", "depth"):
+        with pytest.raises(SceneError, match=f"case.steady.{gone}: no longer a key.*steady.average"):
+            paper(steady={gone: 0.02})
+    with pytest.raises(SceneError, match=r"case.steady.fraction: 0.5 is not in \[0, 0.1\)"):
+        paper(steady={"fraction": 0.5})
 
 
 def test_the_surge_speed_floor_is_half_the_belt_speed_and_each_method_reads_its_own_key():
@@ -208,7 +209,7 @@ def test_killed_run_resumes_to_the_same_result(tmp_path):
     with open(EXAMPLES / "conveyor.yaml") as fh:
         d = yaml.safe_load(fh)
     d.update(dp=2.5e-3, ch=1.5, checkpoint_interval=0.1)
-    d["steady"].update(max_time=0.5, window=0.2)
+    d["steady"].update(max_time=0.5, average=0.2)
     d["probes"].update(interval=0.02)
     case.write_text(yaml.safe_dump(d))
     cmd = [sys.executable, "-m", "solver", "front", str(case), "--quiet"]
@@ -284,7 +285,7 @@ def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
     from solver.front import run_front
     coarse_state(tmp_path / "bad.nc", status="diverged")
     c = paper(start="warm", warm_from=str(tmp_path / "bad.nc"), dp=4.0e-3, ch=1.5,
-              steady={"max_time": 0.05, "window": 0.02, "average": 1.0}, probes={"interval": 0.004})
+              steady={"max_time": 0.05, "average": 0.04}, probes={"interval": 0.004})
     ds = run_front(c)
     assert ds.attrs["status"] == "not_steady"
     assert ds.attrs["warm_start"].startswith("fallback to the lubrication start")

@@ -63,13 +63,17 @@ def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():
 def test_configs_validate_and_expand():
     default = cfgmod.validate(load("config.yaml"))
     cs = cfgmod.cases(default)
-    assert len(cs) == 10  # Ch 1.8 x both methods x 3 dp; skillen at Ch 1.3 and 2.2 on the two coarser
+    # Ch 1.8 x both methods x 3 dp; skillen at Ch 1.3 and 2.2 on the two coarser; then the start checks
+    assert len(cs) == 12 and [c.id for c in cs[10:]] == ["dp1mm_ch1.8_skillen_paper-start",
+                                                         "dp1mm_ch1.8_lind_paper-start"]
+    assert all(c.overrides == cfgmod.PAPER_START for c in cs[10:])
+    cs = cs[:10]
     dps = sorted({c.dp for c in cs})
     assert dps[0] == 0.001 and dps[1] / dps[0] == pytest.approx(dps[2] / dps[1]) == 1.5  # constant ratio
     assert {c.shifting for c in cs if c.dp == 0.001 and c.ch == 1.8} == {"skillen", "lind"}
     paper = cfgmod.validate(load("paper.yaml"))
-    cs = cfgmod.cases(paper)
-    assert len(cs) == 18
+    cs = cfgmod.configured_cases(paper)
+    assert len(cs) == 18 and len(cfgmod.cases(paper)) == 20
     assert {c.dp for c in cs} == {0.001, 0.0005, 0.00025}
     assert {c.ch for c in cs} == {1.0, 1.3, 1.5, 1.8, 2.2}
     assert {c.ch for c in cs if c.shifting == "lind"} == {1.8}
@@ -81,7 +85,7 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisati
     their windows staggered by 0.25 s (``ensemble.window_stagger``)."""
     default = cfgmod.validate(load("config.yaml"))
     acc = cfgmod.validate(load("accuracy.yaml"))
-    cs = cfgmod.cases(acc)
+    cs = cfgmod.configured_cases(acc)
     assert len(cs) == 32 and {c.realisation for c in cs} == set(range(16))
     assert {(c.dp, c.ch) for c in cs} == {(0.001, 1.8)} and {c.shifting for c in cs} == {"skillen", "lind"}
     base = {c.id: cfgmod.case_dict(default, c) for c in cfgmod.cases(default) if c.dp == 0.001}
@@ -93,7 +97,7 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisati
             stem = c.id.rsplit("_r", 1)[0]
             extra = {"name": c.id, "start_perturbation": 1e-3, "perturbation_seed": c.realisation,
                      "steady": {**base[stem]["steady"],
-                                "min_time": base[stem]["steady"]["min_time"] + 0.25 * c.realisation}}
+                                "min_time": base[stem]["steady"].get("min_time", 0.0) + 0.25 * c.realisation}}
             assert d == {**base[stem], **extra}, c.id
 
 
@@ -130,7 +134,7 @@ def test_a_campaign_without_case_keys_is_told_what_case_holds():
 def test_exponent_notation_reads_as_a_number():
     """PyYAML (and Snakemake's config loader) reads 3e-3 as a string; the campaign reads it
     as the number a user means, wherever the schema expects a number."""
-    text = ("case: {}\ngrid: {dp: [3e-3, 2.5e-3], ch: [1.8, 13e-1], shifting: [lind],\n"
+    text = ("case: {}\nstart_check: false\ngrid: {dp: [3e-3, 2.5e-3], ch: [1.8, 13e-1], shifting: [lind],\n"
             "       exclude: [{dp: 3e-3, ch: 1.3}]}\nextra_cases: [{dp: 2e-3, ch: 1.8, shifting: skillen}]\n")
     raw = yaml.safe_load(text)
     assert raw["grid"]["dp"] == ["3e-3", 0.0025]  # what the loader gives: 3e-3 a string
@@ -150,7 +154,7 @@ def test_command_line_strings_read_as_the_schema_types():
     c.update(ensemble={"realisations": "4", "perturbation": "1e-3"}, figures={"dpi": "90"})
     cfg = cfgmod.validate(c)
     assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001, "overrides": [], "window_stagger": 0.0}
-    assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40
+    assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40 + 2  # and the two start checks
     schema = cfgmod.load_schema()
     assert cfgmod.coerce_scalars({"warm_start": "True"}, schema) == {"warm_start": True}
     for key, bad in (("realisations", "4.5"), ("realisations", "four")):
@@ -173,6 +177,7 @@ def test_solver_level_errors_are_caught_before_jobs():
 def test_case_overrides_apply_to_the_matching_cases_only_in_order():
     c = load("config.yaml")
     c["grid"] = {"dp": [2e-3, 1e-3], "ch": [1.8], "shifting": ["skillen", "lind"]}
+    c["start_check"] = False
     c["case_overrides"] = [{"where": {"dp": "1.0e-3"}, "case": {"steady": {"min_time": 2.0}}},
                            {"where": {"dp": 1e-3, "shifting": "lind"}, "case": {"steady": {"min_time": 3.0}}}]
     c["extra_cases"] = [{"dp": 1e-3, "ch": 1.3, "shifting": "skillen", "tag": "own",
@@ -273,7 +278,8 @@ def series_run(depth_noise=0.0, u_noise=0.0, depth_ramp=0.0, seed=0, n=51, windo
          "front_velocity": ((), 0.0)},
         coords={"time": t, "x_star": x, "station": st, "z_star": z},
         attrs={"status": "completed", "h_n_m": hn, "belt_speed_m_s": ub, "normalising_depth_m": 0.0186,
-               "average_window_s": float(t[-1] - t[0])})
+               "average_window_s": float(t[-1] - t[0]), "window_start_s": float(t[0]),
+               "window_end_s": float(t[-1])})
     for k in ("uniform_depth", "surface_elevation", "velocity_star"):
         run[f"mean_{k}"] = run[k].mean("time")
     return run, ref_12
@@ -373,8 +379,8 @@ def dry_run(configfile, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name, n", [("config.yaml", 10), ("paper.yaml", 18), ("accuracy.yaml", 32),
-                                     ("stability.yaml", 22), ("viscoplastic.yaml", 6)])
+@pytest.mark.parametrize("name, n", [("config.yaml", 10 + 2), ("paper.yaml", 18 + 2), ("accuracy.yaml", 32 + 2),
+                                     ("stability.yaml", 22), ("viscoplastic.yaml", 6 + 2)])  # + start checks
 def test_snakemake_dry_run_lists_the_jobs(tmp_path, name, n):
     counts = dry_run(ROOT / "config" / name, tmp_path)
     assert counts["run_case"] == n and counts["metrics"] == n and counts["case_file"] == n
@@ -505,7 +511,7 @@ def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
     with seed k; extra cases run once; a warm start chains within a realisation."""
     from study.config import case_dict, cases, validate, warm_source
     base = {"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind"]},
-            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}]}
+            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}], "start_check": False}
     single = validate(base)
     cfg = validate({**base, "ensemble": {"realisations": 3, "perturbation": 1.0e-5}, "warm_start": True})
     ids = [c.id for c in cases(cfg)]
@@ -549,7 +555,8 @@ def test_ensemble_overrides_set_the_realisations_of_some_grid_points():
     realisation, or its realisation 0 where that point ran fewer; a bad entry is named."""
     from study.config import ConfigError, cases, validate, warm_source
     base = {"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind", "skillen"]},
-            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}], "warm_start": True}
+            "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}], "warm_start": True,
+            "start_check": False}
     cfg = validate({**base, "ensemble": {"realisations": 2, "overrides": [
         {"where": {"dp": "2e-3"}, "realisations": 3},
         {"where": {"dp": 0.002, "shifting": "skillen"}, "realisations": 1}]}})
@@ -592,6 +599,7 @@ def test_each_run_is_scored_against_the_theory_of_its_own_physical_case(tmp_path
     from study.reference import physics_of, recorded_case
     cfg_path = tmp_path / "campaign.yaml"
     cfg_path.write_text(yaml.safe_dump({
+        "start_check": False,
         "case": {"scheme": "spec"}, "grid": {"dp": [3e-3], "ch": [1.5], "shifting": ["skillen"]},
         "extra_cases": [{"dp": 3e-3, "ch": 1.5, "shifting": "skillen", "tag": "slope10",
                          "overrides": {"slope_deg": 10.0}}]}))

@@ -11,8 +11,37 @@ from . import stability
 from .grid import Case
 
 SCALARS = ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se", "zeta_h", "zeta_h_se", "zeta_h_paper",
-           "zeta_h_paper_se", "zeta_fs", "zeta_fs_se", "zeta_fs_measured")
-STATION_METRICS = ("zeta_u", "zeta_u_se", "zeta_u_measured")
+           "zeta_h_paper_se", "zeta_fs", "zeta_fs_se", "zeta_fs_measured",
+           "zeta_f_holdout", "zeta_f_holdout_se", "zeta_h_holdout", "zeta_h_holdout_se",
+           "zeta_fs_holdout", "zeta_fs_holdout_se")
+STATION_METRICS = ("zeta_u", "zeta_u_se", "zeta_u_measured", "zeta_u_holdout", "zeta_u_holdout_se")
+HOLDOUT_Z = 2.0  # a metric differs from its hold-out where |difference| > HOLDOUT_Z se of the difference
+
+
+def holdout_shift(value, se, holdout, holdout_se):
+    """(hold-out - value, its se, whether they differ by more than HOLDOUT_Z se), elementwise."""
+    diff = np.asarray(holdout, dtype=float) - np.asarray(value, dtype=float)
+    se_diff = np.hypot(np.asarray(se, dtype=float), np.asarray(holdout_se, dtype=float))
+    with np.errstate(invalid="ignore"):
+        differs = np.isfinite(diff) & np.isfinite(se_diff) & (np.abs(diff) > HOLDOUT_Z * se_diff)
+    return diff, se_diff, differs
+
+
+def holdout_moves(ds: xr.Dataset, i: int) -> list[tuple[str, float, float]]:
+    """The metrics of case i (in the case table) whose hold-out differs from their value by more
+    than HOLDOUT_Z se: (name, hold-out - value, se of the difference)."""
+    out = []
+    names = [(k, k, None) for k in ("zeta_f", "zeta_h", "zeta_fs")]
+    names += [(f"zeta_u x*={s:g}", "zeta_u", j) for j, s in enumerate(ds["station"].values)]
+    for name, k, j in names:
+        if f"case_{k}_holdout" not in ds:
+            continue
+        at = (i,) if j is None else (i, j)
+        diff, se, differs = holdout_shift(*(ds[f"case_{k}{e}"].values[at] for e in ("", "_se", "_holdout",
+                                                                                   "_holdout_se")))
+        if differs:
+            out.append((name, float(diff), float(se)))
+    return out
 RUN_NUMBERS = {
     "wall_time": ("wall_time_s", "s", "wall-clock time of the run"),
     "steps": ("steps", "1", "time steps"),
@@ -206,6 +235,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["case_ch"] = ("case", [c.ch for c in cases])
     ds["case_shifting"] = ("case", [c.shifting for c in cases])
     ds["case_on_grid"] = ("case", [int(c.on_grid) for c in cases])
+    ds["case_tag"] = ("case", np.array([c.tag or "" for c in cases], dtype=str))
     ds["case_status"] = ("case", [r.attrs["status"] for r in runs])
     ds["case_steady"] = ("case", [int(m["steady"]) for m in metrics])
     ds["case_reason"] = ("case", [r.attrs["reason"] for r in runs])
@@ -213,7 +243,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
         ds[f"case_{k}"] = ("case", [float(r.attrs.get(attr, np.nan)) for r in runs], {"units": units})
     for k in SCALARS:
         ds[f"case_{k}"] = ("case", [float(m[k]) if k in m else np.nan for m in metrics])
-    for k in ("zeta_u", "zeta_u_se"):
+    for k in ("zeta_u", "zeta_u_se", "zeta_u_holdout", "zeta_u_holdout_se"):
         ds[f"case_{k}"] = (("case", "station"), np.stack([m[k].values if k in m else np.full(stations.size, np.nan)
                                                          for m in metrics]))
     # stability: margins to each guard, the detector that fired, the swept settings

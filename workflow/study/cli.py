@@ -80,7 +80,9 @@ def cmd_reduce(a):
     recorded = [recorded_case(r) or solver_case(cfg, c) for r, c in zip(runs, cs)]
     physics = [physics_of(case) for case in recorded]
     ds.attrs["schemes"] = ", ".join(sorted({case.scheme for case in recorded}))
-    ds.attrs["starts"] = "; ".join(sorted({start_description(case) for case in recorded}))
+    from .config import START_CHECK_TAG
+    ds.attrs["starts"] = "; ".join(sorted({start_description(case) for case, c in zip(recorded, cs)
+                                           if c.tag != START_CHECK_TAG}))
     mixed = [c.id for c, p in zip(cs, physics) if p != physics[0]]
     if mixed:  # each run was scored against its own theory; one h_n or slope would misstate them
         ds.attrs["physics_differ"] = (f"{', '.join(mixed)} differ in physics from {cs[0].id}: each run's "

@@ -125,7 +125,43 @@ def load(path) -> dict:
 
 
 def cases(cfg: dict) -> list[Case]:
+    """The grid's cases, the extra cases, then the start checks (``start_checks``)."""
+    found = configured_cases(cfg)
+    return found + start_checks(cfg, found)
+
+
+def configured_cases(cfg: dict) -> list[Case]:
+    """The grid's cases and the extra cases, as the config lists them."""
     return expand(cfg["grid"], cfg.get("extra_cases"), lambda *point: realisations(cfg, *point))
+
+
+START_CHECK_TAG = "paper-start"
+PAPER_START = {"start": "block", "start_velocity": "rest"}  # a block at rest, the belt ramped from rest
+
+
+def start_checks(cfg: dict, found: list[Case]) -> list[Case]:
+    """With ``start_check``: at the finest grid dp, for each shifting method, the grid case at the
+    Ch nearest grid.paper_ch run once more from the paper's start (``PAPER_START``), tagged
+    START_CHECK_TAG. None where the campaign's own cases start that way already."""
+    grid = [c for c in found if c.on_grid and c.realisation == 0]
+    if not cfg.get("start_check", True) or not grid:
+        return []
+    finest = min(c.dp for c in grid)
+    paper_ch = float(cfg["grid"].get("paper_ch", 1.8))
+    checks = []
+    for sh in dict.fromkeys(c.shifting for c in grid if c.dp == finest):
+        c = min((c for c in grid if c.dp == finest and c.shifting == sh), key=lambda c: (abs(c.ch - paper_ch), c.ch))
+        checks.append(Case(c.dp, c.ch, sh, START_CHECK_TAG, dict(PAPER_START)))
+    from solver.conveyor import case_from_dict
+    from solver.scene import SceneError
+    try:
+        own = case_from_dict(case_dict(cfg, grid[0]))
+    except SceneError:  # validate() reports it, naming the case
+        own = None
+    if own is not None and all(getattr(own, k) == v for k, v in PAPER_START.items()):
+        return []
+    taken = {c.id for c in found}
+    return [c for c in checks if c.id not in taken]
 
 
 def realisations(cfg: dict, dp: float, ch: float, shifting: str) -> int:
@@ -150,7 +186,7 @@ def warm_source(cfg: dict, case: Case) -> Case | None:
     grid point ran fewer; None for the coarsest and extra cases."""
     if not cfg.get("warm_start") or not case.on_grid:
         return None
-    coarser = [c for c in cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
+    coarser = [c for c in configured_cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
                and c.dp > case.dp]
     if not coarser:
         return None

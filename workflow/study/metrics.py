@@ -112,18 +112,36 @@ def profile_metrics(depth: float, surface: xr.DataArray, velocity: xr.DataArray,
     return out, zu
 
 
-def window_samples(run: xr.Dataset) -> np.ndarray | None:
-    """Indices of the time samples the run's ``mean_*`` were taken over: its record's final
-    ``average_window_s`` (a run ends with its averaging window). None where the record lacks
-    them or their mean does not reproduce the stored ``mean_uniform_depth``."""
-    if "uniform_depth" not in run or "average_window_s" not in run.attrs or run.sizes.get("time", 0) == 0:
+def _samples(run: xr.Dataset, start_attr: str, end_attr: str) -> np.ndarray | None:
+    """Indices of the time samples in [run.attrs[start_attr], run.attrs[end_attr]] (None where
+    the run lacks the record or the window)."""
+    if "uniform_depth" not in run or run.sizes.get("time", 0) == 0:
+        return None
+    a, b = float(run.attrs.get(start_attr, np.nan)), float(run.attrs.get(end_attr, np.nan))
+    if not (np.isfinite(a) and np.isfinite(b)):
         return None
     t = run["time"].values
-    idx = np.flatnonzero(t >= t[-1] - float(run.attrs["average_window_s"]) - 1e-9)
+    idx = np.flatnonzero((t >= a - 1e-9) & (t <= b + 1e-9))
+    return idx if idx.size else None
+
+
+def window_samples(run: xr.Dataset) -> np.ndarray | None:
+    """Indices of the time samples the run's ``mean_*`` were taken over (its averaging window,
+    attrs window_start_s to window_end_s). None where the record lacks them or their mean does
+    not reproduce the stored ``mean_uniform_depth``."""
+    idx = _samples(run, "window_start_s", "window_end_s")
+    if idx is None:
+        return None
     depth = run["uniform_depth"].values[idx]
     if not np.isclose(np.nanmean(depth), float(run["mean_uniform_depth"]), rtol=1e-9, atol=0.0):
         return None
     return idx
+
+
+def holdout_samples(run: xr.Dataset) -> np.ndarray | None:
+    """Indices of the hold-out window's samples (attrs holdout_start_s to holdout_end_s), None
+    where the run has none."""
+    return _samples(run, "holdout_start_s", "holdout_end_s")
 
 
 def jackknife_se(leave_one_out: np.ndarray) -> np.ndarray:
@@ -156,17 +174,36 @@ def window_errors(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, x_star_rang
     return se, jackknife_se(np.array(zus))
 
 
+HOLDOUT_METRICS = ("zeta_f", "zeta_h", "zeta_fs")
+
+
+def holdout_metrics(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, x_star_range=(0.0, 12.0)):
+    """zeta_f, zeta_h, zeta_fs and zeta_u over the samples ``idx`` (the hold-out window), each
+    with its standard error as over the averaging window: ({name: (value, se)}, zeta_u, its se)."""
+    sub = run.isel(time=idx)
+    t, ub = sub["time"].values, float(run.attrs["belt_speed_m_s"])
+    s, zu = profile_metrics(float(sub["uniform_depth"].mean("time")), sub["surface_elevation"].mean("time"),
+                            sub["velocity_star"].mean("time"), run, ref, x_star_range)
+    se, zu_se = window_errors(run, ref, idx, x_star_range)
+    out = {k: (s[k], se[k]) for k in ("zeta_h", "zeta_fs")}
+    out["zeta_f"] = last_second_velocity(t, sub["toe_position"].values, ub)
+    return out, zu, zu_se
+
+
 def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
                  measured: dict | None = None) -> xr.Dataset:
-    """All metrics of one run against the reference (and measured data when given).
+    """All metrics of one run against the reference (and measured data when given), over its
+    averaging window, and the same over its hold-out window (``*_holdout``) where it has one.
 
     Diverged runs give NaN metrics. A run that did not reach steady state gives its metrics
     over its final window, flagged by ``steady = 0`` (the report and figures mark them).
     """
     st = ref["station"].values
     out = {k: np.nan for k in ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se") + PROFILE_METRICS
-           + tuple(f"{k}_se" for k in PROFILE_METRICS)}
+           + tuple(f"{k}_se" for k in PROFILE_METRICS)
+           + tuple(f"{k}_holdout{e}" for k in HOLDOUT_METRICS for e in ("", "_se"))}
     zu, zu_se = np.full(st.size, np.nan), np.full(st.size, np.nan)
+    zu_hold, zu_hold_se = np.full(st.size, np.nan), np.full(st.size, np.nan)
     meas = {"zeta_fs_measured": np.nan}
     zu_meas = np.full(st.size, np.nan)
     ok = run.attrs.get("status") in ("completed", "not_steady") and "mean_surface_elevation" in run
@@ -174,19 +211,26 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         hn = float(run.attrs["h_n_m"])
         ub = float(run.attrs["belt_speed_m_s"])
         out["zeta_f"] = zeta_f(float(run["front_velocity"]), ub)
-        if "toe_position" in run:  # the probe record (absent from hand-made means-only runs)
-            out["zeta_f_se"] = zeta_f_error(run["time"].values, run["toe_position"].values, ub)
-        if "front_equivalent" in run:
-            out["zeta_f_body"], out["zeta_f_body_se"] = front_body_velocity_error(
-                run["time"].values, run["front_equivalent"].values, ub)
+        idx = window_samples(run)
+        if "toe_position" in run:  # zeta_f's second: the window's last (the record's, without a window)
+            end = idx[-1] + 1 if idx is not None else run.sizes["time"]
+            t = run["time"].values[:end]
+            out["zeta_f_se"] = zeta_f_error(t, run["toe_position"].values[:end], ub)
+            if "front_equivalent" in run:
+                out["zeta_f_body"], out["zeta_f_body_se"] = front_body_velocity_error(
+                    t, run["front_equivalent"].values[:end], ub)
         surf = run["mean_surface_elevation"]
         vel = run["mean_velocity_star"]
         scalars, zu = profile_metrics(float(run["mean_uniform_depth"]), surf, vel, run, ref, x_star_range)
         out.update(scalars)
-        idx = window_samples(run)
         if idx is not None:
             se, zu_se = window_errors(run, ref, idx, x_star_range)
             out.update({f"{k}_se": v for k, v in se.items()})
+        hold = holdout_samples(run)
+        if hold is not None and idx is not None and "toe_position" in run:
+            h, zu_hold, zu_hold_se = holdout_metrics(run, ref, hold, x_star_range)
+            for k, (v, e) in h.items():
+                out[f"{k}_holdout"], out[f"{k}_holdout_se"] = v, e
         if measured:
             if measured.get("surface") is not None:
                 meas["zeta_fs_measured"] = zeta_fs(measured["surface"], surf / hn)
@@ -198,6 +242,8 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     data["zeta_u"] = (("station",), zu)
     data["zeta_u_se"] = (("station",), zu_se)
     data["zeta_u_measured"] = (("station",), zu_meas)
+    data["zeta_u_holdout"] = (("station",), zu_hold)
+    data["zeta_u_holdout_se"] = (("station",), zu_hold_se)
     data["steady"] = ((), int(run.attrs.get("steady", 0)) if ok else 0)
     ds = xr.Dataset(data, coords={"station": st})
     ds["steady"].attrs.update(units="1", long_name="1: metrics over a steady window; 0: not steady or no metrics")
@@ -219,6 +265,9 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         "zeta_u_se": "standard error of zeta_u over the averaging window (block jackknife)",
         "zeta_fs_measured": "free-surface RMS error against measured data",
         "zeta_u_measured": "velocity-profile RMS error against measured data",
+        **{f"{k}_holdout": f"{k} over the hold-out window (the window after the averaging window)"
+           for k in HOLDOUT_METRICS + ("zeta_u",)},
+        **{f"{k}_holdout_se": f"standard error of {k}_holdout" for k in HOLDOUT_METRICS + ("zeta_u",)},
     }
     for k, v in attrs.items():
         ds[k].attrs.update(units="1", long_name=v)

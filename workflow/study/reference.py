@@ -36,10 +36,8 @@ PHYSICAL_KEYS = ("density", "viscosity", "rheology", "yield_stress", "consistenc
 
 def recorded_case(run: xr.Dataset):
     """The solver case a run recorded (its ``case_yaml``), or None for a run without one."""
-    import yaml
-    from solver.conveyor import case_from_dict
-    text = run.attrs.get("case_yaml")
-    return case_from_dict(yaml.safe_load(text)) if text else None
+    from solver.front import recorded_case as from_record
+    return from_record(run) if run.attrs.get("case_yaml") else None
 
 
 def physics_of(case) -> dict:

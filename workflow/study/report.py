@@ -65,6 +65,7 @@ def case_table(ds: xr.Dataset) -> str:
             "zeta_f (± 2 se)", "zeta_f of the front's body (± 2 se)", "zeta_h (h_n, ± 2 se)",
             "zeta_h (paper, ± 2 se)", "zeta_fs (± 2 se)"] + [
                 f"zeta_u x*={s:g} (± 2 se)" for s in st]
+    head.append("hold-out: metrics that moved by more than 2 se")
     rows = []
     for i, cid in enumerate(ds["case"].values):
         status = str(ds["case_status"].values[i])
@@ -82,9 +83,52 @@ def case_table(ds: xr.Dataset) -> str:
         for j in range(st.size):
             se = ds["case_zeta_u_se"].values[i, j] if "case_zeta_u_se" in ds else None
             cells.append(f"<td>{_with_error(ds['case_zeta_u'].values[i, j], se)}</td>")
+        cells.append(f'<td class="l">{holdout_note(ds, i)}</td>')
         rows.append(f'<tr class="{html.escape(status)}">' + "".join(cells) + "</tr>")
     th = "".join(f'<th class="{"l" if k < 2 else ""}">{html.escape(h)}</th>' for k, h in enumerate(head))
     return f"<table><tr>{th}</tr>{''.join(rows)}</table>"
+
+
+def holdout_note(ds: xr.Dataset, i: int) -> str:
+    """The metrics of case i whose hold-out window differs by more than 2 se, with the change."""
+    from .campaign import holdout_moves
+    if "case_zeta_h_holdout" not in ds or not np.isfinite(ds["case_zeta_h_holdout"].values[i]):
+        return "no hold-out"
+    moves = holdout_moves(ds, i)
+    return "; ".join(f"{html.escape(k)} {d:+.2g} (2 se {2 * e:.2g})" for k, d, e in moves) or "none"
+
+
+def start_check_section(ds: xr.Dataset) -> str:
+    """Each start check: the metrics of both runs side by side, their difference and whether
+    they agree within 2 se; empty without start checks."""
+    from . import startcheck
+    tab = startcheck.table(ds)
+    if tab.sizes["check"] == 0:
+        return ""
+    out = []
+    for c in tab["check"].values:
+        row = tab.sel(check=c)
+        agree = row["agree"].values
+        ok = bool(agree.all())
+        moved = [str(m) for m, a in zip(tab["metric"].values, agree) if not a]
+        steady = "" if bool(row["steady"]) else " (<b>not both steady</b>: indicative only)"
+        out.append(f"<p><b>{html.escape(str(row['own_case'].values))}</b> against <b>{html.escape(str(c))}</b>: "
+                   + ("every metric agrees within 2 se" if ok else f"{len(moved)} of {agree.size} metrics "
+                      f"differ by more than 2 se ({html.escape(', '.join(moved))})")
+                   + steady + ".</p>")
+        cells = "".join(
+            f"<tr><td class='l'>{html.escape(str(m))}</td>"
+            f"<td>{_with_error(row['own'].values[k], row['own_se'].values[k])}</td>"
+            f"<td>{_with_error(row['paper'].values[k], row['paper_se'].values[k])}</td>"
+            f"<td>{_with_error(row['difference'].values[k], row['difference_se'].values[k])}</td>"
+            f"<td class='{'ok' if agree[k] else 'warn'}'>{'yes' if agree[k] else 'no'}</td></tr>"
+            for k, m in enumerate(tab["metric"].values))
+        out.append("<table><tr><th class='l'>metric</th><th>campaign's start (&plusmn; 2 se)</th>"
+                   "<th>paper's start (&plusmn; 2 se)</th><th>difference (&plusmn; 2 se)</th>"
+                   f"<th>within 2 se</th></tr>{cells}</table>")
+    return ("<p>At the finest dp, each shifting method ran once more from the paper's start: a block at rest "
+            "at the normal depth, the belt ramped up from rest. Where the two runs agree, the answer does not "
+            "depend on the start.</p>" + "".join(out))
 
 
 def convergence_table(ds: xr.Dataset) -> str:
@@ -129,6 +173,12 @@ def verdict_table(ds: xr.Dataset) -> str:
         if v.unsteady:
             caveat = (f"<br><small><b>Rests on {len(v.unsteady)} of {len(v.cases)} runs that are not "
                       f"steady</b> ({html.escape(', '.join(v.unsteady))}): indicative only.</small>")
+        ids = list(ds["case"].values)
+        moved = [f"{c}: {holdout_note(ds, ids.index(c))}" for c in v.cases
+                 if c in ids and holdout_note(ds, ids.index(c)) not in ("none", "no hold-out")]
+        if moved:
+            caveat += ("<br><small>Metrics that moved by more than 2 se from the averaging window to the "
+                       "hold-out window after it: " + "; ".join(moved) + ".</small>")
         rows.append(f'<tr><td class="l">{html.escape(v.claim)}</td>'
                     f'<td class="l {VERDICT_CLASS[v.verdict]}"><b>{html.escape(v.verdict)}</b>'
                     f'{"*" if v.unsteady else ""}</td>'
@@ -140,7 +190,9 @@ def verdict_table(ds: xr.Dataset) -> str:
         departs = ("departs from the paper's (docs/scheme.md section 6) as "
                    '<a href="../docs/numerics.md">docs/numerics.md</a> lists' if schemes != "spec"
                    else "is the paper's as written (docs/scheme.md section 6)")
-        start = (f"<p>The runs start from {html.escape(ds.attrs.get('starts', ''))}; their scheme, "
+        check = (" (the start checks, from the paper's start: a block at rest, the belt ramped up from rest)"
+                 if start_check_section(ds) else "")
+        start = (f"<p>The runs start from {html.escape(ds.attrs.get('starts', ''))}{check}; their scheme, "
                  f"{html.escape(schemes)}, {departs}.</p>")
     return (start + f"<p>Each conclusion of the paper, judged on this campaign's own runs at its finest dp "
             f"({finest:g} mm; the paper's finest is {PAPER_FINEST_DP * 1000:g} mm). "
@@ -335,6 +387,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
         f"{html.escape(ds.attrs['rheology'])}, so they are not judged here. Its errors are against "
         "the lubrication reference for that fluid: see Accuracy and cost, and the figures.</p>")
     body = [("Verdict", verdict), ("Accuracy and cost", accuracy_table(ds)),
+            *([("Start check", start_check_section(ds))] if start_check_section(ds) else []),
             ("Summary", summary), ("Figures", "".join(figs)), ("Cases", case_table(ds)),
             ("Convergence", convergence_table(ds)), ("Stability", stability_section(ds)),
             *extra_sections, ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
