@@ -32,12 +32,14 @@ class Settings:
 @dataclass(frozen=True)
 class FigureSpec:
     """One figure of the report: its file name, title, caption and drawing function.
-    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note."""
+    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note; ``when``,
+    given the validated campaign config, says whether the campaign draws it (None: always)."""
     name: str
     title: str
     caption: str
     draw: Callable[[xr.Dataset, Settings], object]
     hollow: bool = False
+    when: Callable[[dict], bool] | None = None
 
     def full_caption(self, profile_ch: float) -> str:
         return self.caption.format(ch=profile_ch) + (HOLLOW if self.hollow else "")
@@ -256,9 +258,16 @@ def fig_plug_map(ds, ch):
             ax.legend(fontsize=7, loc="upper right")  # above the toe, where there is no fluid
             ax.set_aspect("equal")
         else:
-            ax.text(0.5, 0.5, "no yield stress in this campaign (or no final state)",
+            ax.text(0.5, 0.5, "no yield stress in this run (or no final state)",
                     transform=ax.transAxes, ha="center", va="center", color="0.4")
     return _front_panels(ds, ch, draw)
+
+
+def has_yield_stress(config: dict) -> bool:
+    """Whether any case of the validated campaign config, grid or extra, runs a yield-stress
+    (Herschel-Bulkley) fluid: the plug map's condition."""
+    from .config import cases, solver_case
+    return any(not solver_case(config, c).newtonian for c in cases(config))
 
 
 def fig_shifting_comparison(ds, var, ch, station_panels=False):
@@ -443,19 +452,27 @@ FIGURES = (
     FigureSpec("fig13_plug_map", "Where the plug is",
                "For a Herschel-Bulkley fluid: the final fluid particles within 3 h_n of the toe "
                "at the finest dp and Ch = {ch:g}, yielded (viscosity below the cap max_viscosity) "
-               "or unyielded (at the cap: the plug). Not in the paper; empty for a Newtonian "
-               "campaign.",
-               lambda ds, st: fig_plug_map(ds, st.profile_ch)),
+               "or unyielded (at the cap: the plug). Not in the paper; drawn only for a campaign "
+               "with a Herschel-Bulkley case.",
+               lambda ds, st: fig_plug_map(ds, st.profile_ch), when=has_yield_stress),
 )
 FIGURE_NAMES = tuple(f.name for f in FIGURES)
 
 
-def write_all(ds: xr.Dataset, outdir, settings: Settings, fmt: str = "png", dpi: int = 120) -> list[Path]:
-    """Draw every registered figure into outdir/<name>.<fmt> (each written atomically)."""
+def figures_for(config: dict) -> tuple[FigureSpec, ...]:
+    """The registered figures that the campaign of ``config`` (validated: study.config.validate)
+    draws: the rules' outputs, Snakemake's report and the HTML report take these."""
+    return tuple(spec for spec in FIGURES if spec.when is None or spec.when(config))
+
+
+def write_all(ds: xr.Dataset, outdir, settings: Settings, fmt: str = "png", dpi: int = 120,
+              specs=FIGURES) -> list[Path]:
+    """Draw the figures ``specs`` (default: every registered one) into outdir/<name>.<fmt>
+    (each written atomically)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     paths = []
-    for spec in FIGURES:
+    for spec in specs:
         with plt.rc_context(STYLE):
             fig = spec.draw(ds, settings)
         p = outdir / f"{spec.name}.{fmt}"
