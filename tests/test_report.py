@@ -148,3 +148,25 @@ def test_the_verdict_section_says_what_the_runs_start_from_and_which_scheme_they
     ds.attrs.update(schemes="spec", starts=start_description(paper))
     assert "a block at rest at the normal depth, the belt ramped up from rest; their scheme, spec, is the paper's" \
         in html.unescape(verdict_table(ds))
+
+
+def test_the_convergence_table_lists_only_the_sequences_that_have_data():
+    """The default campaign runs Lind at Ch 1.8 only: its excluded (Ch, shifting) sequences,
+    with no value at any dp, get no rows; a sequence with data gets one row per quantity."""
+    from study.report import convergence_table
+    ds = campaign(paper_like)
+    for ch in (1.5, 2.2):  # as the campaign dataset holds the grid's excluded points
+        sel = dict(ch=ch, shifting="lind")
+        ds["uniform_depth"].loc[sel] = np.nan
+        ds["mean_velocity"].loc[sel] = np.nan
+        ds["status"].loc[sel] = "missing"
+    table = convergence_table(ds)
+    rows = table.count("<tr><td")
+    assert rows == 4 * (1 + STATIONS.size)  # skillen at three Ch, lind at 1.8; h_u and u* per station
+    assert '<td class="l">lind</td><td>1.8</td>' in table
+    for ch in ("1.5", "2.2"):
+        assert f'<td class="l">lind</td><td>{ch}</td>' not in table
+        assert f'<td class="l">skillen</td><td>{ch}</td>' in table
+    ds["uniform_depth"][:] = np.nan
+    ds["mean_velocity"][:] = np.nan
+    assert "<table>" not in convergence_table(ds)

@@ -89,7 +89,8 @@ def case_table(ds: xr.Dataset) -> str:
 
 def convergence_table(ds: xr.Dataset) -> str:
     """Observed order, Richardson-extrapolated value and GCI of the uniform depth h_u/h_n and
-    of the station depth-mean u*, for each Ch and shifting with three or more resolutions."""
+    of the station depth-mean u*, for each Ch and shifting with three or more resolutions: the
+    (Ch, shifting) sequences that have data (a grid's excluded or wholly diverged ones do not)."""
     from .convergence import gci
     if ds.sizes["dp"] < 3:
         return "<p>Fewer than three resolutions: no observed order or GCI.</p>"
@@ -102,12 +103,16 @@ def convergence_table(ds: xr.Dataset) -> str:
             with np.errstate(all="ignore"):
                 means = np.nanmean(sub["mean_velocity"].values, axis=2)
             quantities += [(f"mean u* at x* = {s:g}", means[:, j]) for j, s in enumerate(st)]
+            if not any(np.isfinite(phi).any() for _, phi in quantities):
+                continue  # never run, or every run diverged: no sequence to judge
             for name, phi in quantities:
                 r = gci(sub["dp"].values, phi)
                 rows.append(f'<tr><td class="l">{html.escape(str(sh))}</td><td>{ch:g}</td>'
                             f'<td class="l">{html.escape(name)}</td><td class="l">{r.status}</td>'
                             f"<td>{_fmt(r.order)}</td><td>{_fmt(r.extrapolated, 4)}</td>"
                             f"<td>{_fmt(r.gci_fine)}</td><td>{_fmt(r.error_fine)}</td></tr>")
+    if not rows:
+        return "<p>No run finished: no observed order or GCI.</p>"
     head = ("<tr><th class='l'>shifting</th><th>Ch</th><th class='l'>quantity</th>"
             "<th class='l'>sequence</th><th>observed order</th><th>extrapolated</th>"
             "<th>GCI fine</th><th>finest vs extrapolated</th></tr>")
