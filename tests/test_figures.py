@@ -133,3 +133,38 @@ def test_a_newtonian_campaign_neither_draws_nor_reports_the_plug_map(tmp_path):
     assert text.count("<figure ") == len(drawn)
     assert "fig13_plug_map" not in text and "Where the plug is" not in text
     plt.close("all")
+
+
+def _tick_labels(axis):
+    """Every label of the major and minor ticks in view, and the axis's offset text."""
+    lo, hi = sorted(axis.get_view_interval())
+    labels = [t.get_text() for minor in (False, True) for t in axis.get_ticklabels(minor=minor)
+              if t.get_text() and lo <= t.get_position()[axis.axis_name == "y"] <= hi]
+    return labels + [axis.get_offset_text().get_text()]
+
+
+def test_every_axis_of_every_figure_has_plain_tick_labels():
+    """Run times within a factor 2 (30 to 60 s: matplotlib labels a log axis spanning less than
+    a decade at its minor ticks, as 3x10^1) and errors within one decade: every tick label of
+    every figure is a plain number, errors in per cent; no mathtext, no offset."""
+    ds = campaign(metric, steady=lambda dp, ch, sh: dp > 0.001)
+    ds["wall_time"][:] = np.linspace(30, 60, ds["wall_time"].size).reshape(ds["wall_time"].shape)
+    z = np.linspace(0, 1, 11)
+    theory = xr.Dataset({"velocity": (("station", "z_star"), np.tile(1.5 * z, (STATIONS.size, 1)))},
+                        coords={"station": STATIONS, "z_star": z})
+    settings = figures.Settings(1.8, theory)
+    for spec in figures.FIGURES:
+        with plt.rc_context(figures.STYLE):
+            fig = spec.draw(ds, settings)
+            fig.canvas.draw()
+        for ax in fig.axes:
+            for axis in (ax.xaxis, ax.yaxis):
+                for label in _tick_labels(axis):
+                    assert not any(m in label for m in ("$", "10^", "times", "×", "e+", "e-")), (spec.name, label)
+                if axis.get_scale() == "log" and axis.axis_name == "y":  # the errors
+                    assert all(t.endswith(" %") for t in _tick_labels(axis)[:-1]), spec.name
+        if spec.name == "fig11_cost_vs_error":
+            wall = _tick_labels(fig.axes[0].xaxis)
+            assert {"30", "40", "60"} <= set(wall), wall
+            assert set(_tick_labels(fig.axes[0].yaxis)) >= {"1 %", "2 %", "3 %"}
+        plt.close(fig)

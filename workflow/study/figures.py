@@ -11,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
@@ -19,7 +20,8 @@ import xarray as xr  # noqa: E402
 COLOURS = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442", "#000000"]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
 STYLE = {"figure.dpi": 100, "axes.grid": True, "grid.alpha": 0.3, "font.size": 10,
-         "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False}
+         "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
+         "axes.formatter.useoffset": False}  # linear axes: each tick its own plain number
 
 
 @dataclass(frozen=True)
@@ -62,20 +64,21 @@ def _dp_mm(ds):
 def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", invert_x: bool = True,
               dp_ticks=None):
     """Log axes when something was drawn (dp axes run coarse to fine, left to right, ticked
-    at the campaign's dp values in plain numbers); otherwise say there is nothing to draw."""
+    at the campaign's dp values), every tick label a plain number (the y axis, an error, in per
+    cent); otherwise say there is nothing to draw."""
     from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
     if any_data:
         ax.set_xscale("log")
         ax.set_yscale("log")
         if invert_x:
             ax.invert_xaxis()
+        ax.xaxis.set_major_formatter(FuncFormatter(_plain))
+        ax.xaxis.set_minor_formatter(_PlainLogFormatter(_plain))
         if dp_ticks is not None:
             ax.xaxis.set_major_locator(FixedLocator(np.asarray(dp_ticks, dtype=float)))
             ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.xaxis.set_major_formatter(FuncFormatter(_plain))
-        ax.yaxis.set_major_formatter(FuncFormatter(_plain))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _plain(v) if _few_decades(ax)
-                                                   and _mantissa(v) in (2, 3, 5) else ""))
+        ax.yaxis.set_major_formatter(FuncFormatter(_percent_tick))
+        ax.yaxis.set_minor_formatter(_PlainLogFormatter(_percent_tick))
     else:
         ax.text(0.5, 0.5, "no run gave this metric\n(diverged)", transform=ax.transAxes,
                 ha="center", va="center", color="0.4")
@@ -87,13 +90,21 @@ def _plain(v, _pos=None) -> str:
     return f"{v:.4g}" if 1e-4 <= abs(v) < 1e5 else f"{v:.0e}"
 
 
-def _mantissa(v: float) -> int:
-    return round(v / 10 ** np.floor(np.log10(v))) if v > 0 else 0
+def _percent_tick(v, _pos=None) -> str:
+    """A tick label of an error (a fraction) in per cent: 0.005 -> '0.5 %', 0.02 -> '2 %'."""
+    return f"{_plain(100.0 * v)} %"
 
 
-def _few_decades(ax) -> bool:
-    lo, hi = sorted(ax.get_ylim())
-    return lo > 0 and hi / lo < 12  # label minor ticks where a decade has no major one
+class _PlainLogFormatter(matplotlib.ticker.LogFormatter):
+    """The minor ticks of a log axis that matplotlib labels (on an axis spanning about a decade
+    or less: some or all of 2-9 times a power of ten, which it writes 3x10^1), written by
+    ``text`` instead: plain numbers."""
+    def __init__(self, text):
+        super().__init__(labelOnlyBase=False)
+        self.text = text
+
+    def __call__(self, x, pos=None):
+        return self.text(x) if super().__call__(x, pos) else ""
 
 
 def _legend(axes, steadiness: bool = True, **kw):
