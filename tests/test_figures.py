@@ -168,3 +168,9 @@ def test_every_axis_of_every_figure_has_plain_tick_labels():
             assert {"30", "40", "60"} <= set(wall), wall
             assert set(_tick_labels(fig.axes[0].yaxis)) >= {"1 %", "2 %", "3 %"}
         plt.close(fig)
+
+
+def test_no_gci_band_from_an_observed_order_above_4():
+    dp = np.array([0.004, 0.002, 0.001])
+    assert np.isnan(figures._gci_band(dp, 0.02 + 0.01 * (dp / 0.001) ** 6))
+    assert figures._gci_band(dp, 0.02 + 0.01 * (dp / 0.001) ** 3) > 0

@@ -170,3 +170,29 @@ def test_the_convergence_table_lists_only_the_sequences_that_have_data():
     ds["uniform_depth"][:] = np.nan
     ds["mean_velocity"][:] = np.nan
     assert "<table>" not in convergence_table(ds)
+
+
+def test_an_observed_order_above_4_is_flagged_and_not_extrapolated():
+    """zeta_f and the uniform depth of order 6 over dp (4, 2, 1 mm): the accuracy table and the
+    convergence table show the order, flagged unreliable, and no limit, band, GCI or dp from it;
+    first-order metrics keep theirs."""
+    from study.report import accuracy_table, convergence_table
+
+    def steep(name, dp, ch, sh):
+        if name in ("zeta_f", "zeta_h"):
+            return 0.02 + 0.01 * (dp / 0.001) ** 6
+        return paper_like(name, dp, ch, sh)
+    ds = campaign(steep)
+    table = accuracy_table(ds)
+    zeta_f = table[table.index(">zeta_f<"):table.index(">zeta_h<")]
+    assert zeta_f.count("not extrapolated: observed order p = 6, above 4 (unreliable)") == 2  # both methods
+    assert zeta_f.count("&ndash; (order above 4: unreliable)") == 2
+    assert "(p = 6)" not in table and "(p = 1)" in table  # zeta_fs, first order, is extrapolated
+    assert "an order above 4 is unreliable" in table
+    conv = convergence_table(ds)
+    depth = [row for row in conv.split("<tr>") if "h_u / h_n" in row]
+    assert len(depth) == ds.sizes["ch"] * ds.sizes["shifting"]
+    for row in depth:
+        cells = row.split("</td>")
+        assert cells[3].endswith("unreliable") and cells[4].endswith("6 (above 4: unreliable)")
+        assert all(c.endswith("&ndash;") for c in cells[5:8]), row

@@ -15,6 +15,8 @@ import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
+from .verdict import MAX_ORDER  # noqa: E402
+
 
 # Okabe-Ito palette
 COLOURS = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442", "#000000"]
@@ -191,9 +193,10 @@ def _metric_figure(ds, var, ylabel):
 HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over the final window "
           "of a run that did not reach steady state (read them as indicative only). Error bars on "
           "the finest dp: the GCI band of that value (Celik et al. 2008), where the three finest "
-          "dp converge monotonically; on the log axis a band that reaches zero is drawn down to "
-          "5 % of the value. Thin bars without caps: +- 2 standard errors of each run's sampling "
-          "error over its averaging window, the same error the verdicts use.")
+          f"dp converge monotonically at an observed order of at most {MAX_ORDER:g}; on the log "
+          "axis a band that reaches zero is drawn down to 5 % of the value. Thin bars without "
+          "caps: +- 2 standard errors of each run's sampling error over its averaging window, the "
+          "same error the verdicts use.")
 
 
 def fig_velocity_profiles(ds, ch, ref):

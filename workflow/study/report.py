@@ -92,6 +92,7 @@ def convergence_table(ds: xr.Dataset) -> str:
     of the station depth-mean u*, for each Ch and shifting with three or more resolutions: the
     (Ch, shifting) sequences that have data (a grid's excluded or wholly diverged ones do not)."""
     from .convergence import gci
+    from .verdict import MAX_ORDER
     if ds.sizes["dp"] < 3:
         return "<p>Fewer than three resolutions: no observed order or GCI.</p>"
     st = ds["station"].values
@@ -107,9 +108,13 @@ def convergence_table(ds: xr.Dataset) -> str:
                 continue  # never run, or every run diverged: no sequence to judge
             for name, phi in quantities:
                 r = gci(sub["dp"].values, phi)
+                order = _fmt(r.order)
+                if r.status == "monotone" and r.order > MAX_ORDER:  # its order alone, flagged
+                    order += f" (above {MAX_ORDER:g}: unreliable)"
+                    r = type(r)("unreliable", r.order)
                 rows.append(f'<tr><td class="l">{html.escape(str(sh))}</td><td>{ch:g}</td>'
                             f'<td class="l">{html.escape(name)}</td><td class="l">{r.status}</td>'
-                            f"<td>{_fmt(r.order)}</td><td>{_fmt(r.extrapolated, 4)}</td>"
+                            f"<td>{order}</td><td>{_fmt(r.extrapolated, 4)}</td>"
                             f"<td>{_fmt(r.gci_fine)}</td><td>{_fmt(r.error_fine)}</td></tr>")
     if not rows:
         return "<p>No run finished: no observed order or GCI.</p>"
@@ -117,8 +122,9 @@ def convergence_table(ds: xr.Dataset) -> str:
             "<th class='l'>sequence</th><th>observed order</th><th>extrapolated</th>"
             "<th>GCI fine</th><th>finest vs extrapolated</th></tr>")
     return ("<p>Grid Convergence Index (Celik et al. 2008) over the three finest resolutions; "
-            "oscillatory or divergent sequences are flagged and given no number. Runs that were "
-            "not steady enter with their final-window values.</p>"
+            "oscillatory or divergent sequences are flagged and given no number, and a monotone one "
+            f"whose observed order is above {MAX_ORDER:g} is flagged unreliable and given its order "
+            "alone. Runs that were not steady enter with their final-window values.</p>"
             f"<table>{head}{''.join(rows)}</table>")
 
 
@@ -161,7 +167,7 @@ def verdict_table(ds: xr.Dataset) -> str:
 def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
     """Per metric: the cheapest steady run under each threshold, and per shifting method at
     the paper's Ch the GCI-extrapolated value, its band and the dp needed for 1 %."""
-    from .verdict import MIN_ORDER, accuracy_rows
+    from .verdict import MAX_ORDER, MIN_ORDER, accuracy_rows
     rows = accuracy_rows(ds, thresholds)
     out, last = [], None
     for r in rows:
@@ -179,6 +185,10 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
             need = (f"&ndash; (order below {MIN_ORDER:g}: not converging yet)" if np.isnan(x.dp_needed)
                     else "never (limit above 1 %)" if not np.isfinite(x.dp_needed)
                     else f"{x.dp_needed * 1000:.3g} mm")
+        elif x.status == "unreliable":
+            lim = f"not extrapolated: observed order p = {x.order:.2g}, above {MAX_ORDER:g} (unreliable)"
+            need = (f"{x.dp_needed * 1000:.3g} mm" if np.isfinite(x.dp_needed)
+                    else f"&ndash; (order above {MAX_ORDER:g}: unreliable)")
         else:
             lim, need = html.escape(x.status), "&ndash;"
         two_se = r["finest_two_se"]
@@ -202,7 +212,8 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
             "Ch, the metric at the finest dp, its Richardson limit with the GCI band of the finest "
             "value (Celik et al. 2008; only for monotone sequences over the three finest dp) and "
             "the dp at which zeta = limit + C dp^p reaches 1 % (not projected from an observed "
-            f"order p below {MIN_ORDER:g}).</p>"
+            f"order p below {MIN_ORDER:g}; an order above {MAX_ORDER:g} is unreliable, and neither "
+            "limit, band nor dp is extrapolated from it).</p>"
             f"<table>{head}{''.join(out)}</table>")
 
 
