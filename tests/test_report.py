@@ -27,27 +27,42 @@ def test_the_report_opens_with_the_verdict():
 
 def test_the_case_table_gives_the_metrics_with_their_sampling_error():
     """zeta_f is shown as value +- 2 se where the run carries its standard error, alone where
-    it does not (metrics written before the error was kept)."""
+    it does not (metrics written before the error was kept); both in per cent to two
+    significant digits."""
     from study.report import case_table
     ds = campaign(paper_like)
     ds["case_zeta_f"][:] = 0.0077
     ds["case_zeta_f_se"] = xr.full_like(ds["case_zeta_f"], 0.0105)
     ds["case_zeta_f_se"][0] = np.nan
     table = case_table(ds)
-    assert table.count("0.0077 &plusmn; 0.021") == ds.sizes["case"] - 1
-    assert "zeta_f (± 2 se)" in table
+    assert table.count("0.77 % &plusmn; 2.1 %") == ds.sizes["case"] - 1
+    assert table.count("<td>0.77 %</td>") == 1
+    assert "zeta_f [%] (± 2 se)" in table
     # the front body's error beside it; a dash where the metrics predate it
     dashes = table.count("<td>&ndash;</td>")
     ds["case_zeta_f_body"] = xr.full_like(ds["case_zeta_f"], 0.00357)
     ds["case_zeta_f_body_se"] = xr.full_like(ds["case_zeta_f"], 0.000105)
     table = case_table(ds)
-    assert table.count("0.00357 &plusmn; 0.00021") == ds.sizes["case"]
+    assert table.count("0.36 % &plusmn; 0.021 %") == ds.sizes["case"]
     assert dashes - table.count("<td>&ndash;</td>") == ds.sizes["case"]
-    # zeta_u's jackknife error, in plain decimals to two digits
+    # zeta_u's jackknife error
     ds["case_zeta_u"][:] = 0.0159
     ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], 0.00029)
     table = case_table(ds)
-    assert table.count("0.0159 &plusmn; 0.00058") == ds.sizes["case"] * ds.sizes["station"]
+    assert table.count("1.6 % &plusmn; 0.058 %") == ds.sizes["case"] * ds.sizes["station"]
+    assert "zeta_u x*=0.76 [%] (± 2 se)" in table
+    # the two the case table mixed as 4.537e-04 ± 0.0016 and 0.0816 ± 0.015
+    ds["case_zeta_fs"][:2] = [4.537e-4, 0.0816]
+    ds["case_zeta_fs_se"] = ("case", [0.0008, 0.0075] + [np.nan] * (ds.sizes["case"] - 2))
+    table = case_table(ds)
+    assert "<td>0.045 % &plusmn; 0.16 %</td>" in table and "<td>8.2 % &plusmn; 1.5 %</td>" in table
+
+
+def test_an_error_reads_in_per_cent_to_two_significant_digits():
+    from study.numbers import percent
+    assert [percent(v) for v in (4.537e-4, 0.0016, 0.0816, 0.015, 0.01, 1.234, 0.0)] == [
+        "0.045 %", "0.16 %", "8.2 %", "1.5 %", "1 %", "120 %", "0 %"]
+    assert percent(np.nan) == "-" and percent(np.inf, "&ndash;") == "&ndash;"
 
 
 def test_the_case_table_gives_the_acoustic_cfl_each_run_used():
@@ -114,7 +129,7 @@ def test_an_ensemble_campaign_says_what_its_grid_values_and_errors_are():
     assert "realisation k's steady.min_time is raised by k &times; 0.25 s" in render(ds, [], "grid: {}")
     n_points = ds["wall_time"].size
     assert f"{ds.sizes['case']} cases ({n_points} grid points; every grid case ran in 3 realisations)" in text
-    assert "cheapest steady grid point &le; 0.01" in text
+    assert "cheapest steady grid point &le; 1 %" in text
 
 
 def test_an_ensemble_of_different_sizes_names_its_grid_points_by_count():

@@ -166,7 +166,7 @@ def test_the_accuracy_table_gives_the_finest_value_with_its_sampling_error():
     ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.0015)
     rows = [r for r in accuracy_rows(ds) if r["metric"] == "zeta_f"]
     assert len(rows) == 2 and all(r["finest_two_se"] == pytest.approx(0.003) for r in rows)
-    assert accuracy_table(ds).count("&plusmn; 0.003<") == 2
+    assert accuracy_table(ds).count("&plusmn; 0.3 %<") == 2  # in per cent, as the value
     ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], np.nan)
     assert accuracy_table(ds).count("&plusmn; (se unknown)") == 2
 
@@ -218,14 +218,15 @@ def test_a_zeta_f_whose_sampling_error_is_unknown_decides_nothing():
 def test_a_zeta_u_difference_within_its_sampling_error_does_not_contradict():
     """The opposite campaign: lind's zeta_u is 3x skillen's, at dp = 1 mm 0.036 / 0.096 / 0.126
     against 0.012 / 0.032 / 0.042 (differences 0.024 / 0.064 / 0.084). With se = 0.001 a run
-    the marginal claim is contradicted and its evidence shows the 2 se of the difference; with
+    the marginal claim is contradicted and its evidence shows the 2 se of the difference (2
+    sqrt(2) 0.001), in per cent to two significant digits as the errors; with
     se = 0.03 (2 se of a difference 0.085) no difference exceeds 1 % of u_b by more than 2 se:
     not reproduced; nor with an unknown se."""
     ds = campaign(opposite)
     ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], 0.001)
     v = by_claim(ds)["marginal"]
     assert v.verdict == "contradicted"
-    assert "x* = 9.7: lind 0.126, skillen 0.042 (difference 0.084 ± 0.003, 2 se)" in v.evidence
+    assert "x* = 9.7: lind 13 %, skillen 4.2 % (difference 8.4 % ± 0.28 %, 2 se)" in v.evidence
     for se in (0.03, np.nan):
         ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], se)
         assert by_claim(ds)["marginal"].verdict == "not reproduced"

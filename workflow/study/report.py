@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from .campaign import ensemble_size
+from .numbers import percent
 
 CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;
@@ -52,19 +53,19 @@ def _commit() -> str:
 
 
 def _with_error(value, se) -> str:
-    """value +- 2 se (its sampling error), or the value alone where se is unknown."""
+    """An error (a fraction) in per cent +- 2 se (its sampling error), both to two significant
+    digits, or the value alone where se is unknown."""
     if se is None or not np.isfinite(se) or not np.isfinite(value):
-        return _fmt(value)
-    two_se = np.format_float_positional(2.0 * se, precision=2, unique=False, fractional=False, trim="-")
-    return f"{_fmt(value)} &plusmn; {two_se}"
+        return percent(value, "&ndash;")
+    return f"{percent(value)} &plusmn; {percent(2.0 * se)}"
 
 
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
     head = ["case", "status", "steady", "wall time [s]", "steps", "C_CFL used", "particles", "steady at [s]",
-            "zeta_f (± 2 se)", "zeta_f of the front's body (± 2 se)", "zeta_h (h_n, ± 2 se)",
-            "zeta_h (paper, ± 2 se)", "zeta_fs (± 2 se)"] + [
-                f"zeta_u x*={s:g} (± 2 se)" for s in st]
+            "zeta_f [%] (± 2 se)", "zeta_f of the front's body [%] (± 2 se)", "zeta_h [%] (h_n, ± 2 se)",
+            "zeta_h [%] (paper, ± 2 se)", "zeta_fs [%] (± 2 se)"] + [
+                f"zeta_u x*={s:g} [%] (± 2 se)" for s in st]
     rows = []
     for i, cid in enumerate(ds["case"].values):
         status = str(ds["case_status"].values[i])
@@ -115,12 +116,13 @@ def convergence_table(ds: xr.Dataset) -> str:
                 rows.append(f'<tr><td class="l">{html.escape(str(sh))}</td><td>{ch:g}</td>'
                             f'<td class="l">{html.escape(name)}</td><td class="l">{r.status}</td>'
                             f"<td>{order}</td><td>{_fmt(r.extrapolated, 4)}</td>"
-                            f"<td>{_fmt(r.gci_fine)}</td><td>{_fmt(r.error_fine)}</td></tr>")
+                            f"<td>{percent(r.gci_fine, '&ndash;')}</td>"
+                            f"<td>{percent(r.error_fine, '&ndash;')}</td></tr>")
     if not rows:
         return "<p>No run finished: no observed order or GCI.</p>"
     head = ("<tr><th class='l'>shifting</th><th>Ch</th><th class='l'>quantity</th>"
             "<th class='l'>sequence</th><th>observed order</th><th>extrapolated</th>"
-            "<th>GCI fine</th><th>finest vs extrapolated</th></tr>")
+            "<th>GCI fine [%]</th><th>finest vs extrapolated [%]</th></tr>")
     return ("<p>Grid Convergence Index (Celik et al. 2008) over the three finest resolutions; "
             "oscillatory or divergent sequences are flagged and given no number, and a monotone one "
             f"whose observed order is above {MAX_ORDER:g} is flagged unreliable and given its order "
@@ -176,12 +178,12 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
         cells = [f'<td class="l">{html.escape(r["metric"]) if first else ""}</td>']
         for thr in thresholds:
             c = r["cheapest"][thr]
-            txt = "none" if c is None else (f"{c[0]} ({c[1]:.0f} s, {c[2]:.3g}"
-                                            + ("" if c[3] is None else f" ± {c[3]:.2g}") + ")")
+            txt = "none" if c is None else (f"{c[0]} ({c[1]:.0f} s, {percent(c[2])}"
+                                            + ("" if c[3] is None else f" ± {percent(c[3])}") + ")")
             cells.append(f'<td class="l">{html.escape(txt) if first else ""}</td>')
         x = r["extrapolation"]
         if x.status == "monotone":
-            lim = f"{_fmt(x.extrapolated)} &plusmn; {_fmt(x.band, 2)} (p = {x.order:.2g})"
+            lim = f"{percent(x.extrapolated)} &plusmn; {percent(x.band)} (p = {x.order:.2g})"
             need = (f"&ndash; (order below {MIN_ORDER:g}: not converging yet)" if np.isnan(x.dp_needed)
                     else "never (limit above 1 %)" if not np.isfinite(x.dp_needed)
                     else f"{x.dp_needed * 1000:.3g} mm")
@@ -192,19 +194,20 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
         else:
             lim, need = html.escape(x.status), "&ndash;"
         two_se = r["finest_two_se"]
-        finest = _fmt(x.finest) + ("" if two_se == 0 or not np.isfinite(x.finest)
-                                   else " &plusmn; (se unknown)" if not np.isfinite(two_se)
-                                   else f" &plusmn; {two_se:.2g}")
+        finest = percent(x.finest, "&ndash;") + ("" if two_se == 0 or not np.isfinite(x.finest)
+                                                 else " &plusmn; (se unknown)" if not np.isfinite(two_se)
+                                                 else f" &plusmn; {percent(two_se)}")
         cells += [f'<td class="l">{html.escape(r["shifting"])}</td>', f"<td>{finest}</td>",
                   f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
         out.append("<tr>" + "".join(cells) + "</tr>")
     ch = rows[0]["ch"] if rows else float("nan")
     ensemble = ensemble_size(ds) > 1
     unit = "grid point" if ensemble else "run"
-    head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady {unit} &le; {t:g}</th>"
-                                                     for t in thresholds)
-            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp &plusmn; 2 se</th>"
-            "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
+    head = ("<tr><th class='l'>metric</th>"
+            + "".join(f"<th class='l'>cheapest steady {unit} &le; {percent(t)}</th>"
+                      for t in thresholds)
+            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp [%] &plusmn; 2 se</th>"
+            "<th class='l'>GCI limit dp &rarr; 0 [%] &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
     what = ("grid point (a realisation's mean wall time, the realisations' mean error and the ensemble's se)"
             if ensemble else "run (wall time, error)")
     return (f"<p>The cheapest steady {what} meeting each threshold over the whole "

@@ -27,6 +27,7 @@ import xarray as xr
 
 from .campaign import ensemble_size
 from .convergence import gci
+from .numbers import percent
 
 PAPER_CH = 1.8
 PAPER_FINEST_DP = 0.25e-3
@@ -142,7 +143,7 @@ def _finest_dp(da: xr.DataArray):
 
 
 def _pct(v):
-    return "-" if not np.isfinite(v) else f"{100 * v:.2g} %"
+    return percent(v)
 
 
 def _mm(dp):
@@ -339,8 +340,8 @@ def marginal_shifting_claim(ds, claim):
         elif max(lv, sv) > 2 * min(lv, sv) and diff - two_se > MARGINAL_U:
             large += 1
         noise = "" if two_se == 0 else (" (difference ± 2 se unknown)" if not np.isfinite(two_se)
-                                        else f" (difference {diff:.3f} ± {two_se:.3f}, 2 se)")
-        parts.append(f"x* = {x:g}: lind {lv:.3f}, skillen {sv:.3f}{noise}")
+                                        else f" (difference {_pct(diff)} ± {_pct(two_se)}, 2 se)")
+        parts.append(f"x* = {x:g}: lind {_pct(lv)}, skillen {_pct(sv)}{noise}")
     verdict = ("reproduced" if marginal == st.size else "contradicted" if large else "not reproduced")
     evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts)
     sels = [dict(dp=dp, ch=ch, shifting=s) for s in ("lind", "skillen")]
@@ -372,7 +373,7 @@ def velocity_claim(ds, claim):
         toe_smallest += bool(others.size and np.all(u[others] - u[toe] > gap))
         sels.append(dict(dp=dp, ch=float(ch), shifting=sh))
         parts.append(f"Ch {ch:g} at {_mm(dp)}: " + ", ".join(
-            f"{v:.3f}" + (f" ± {2 * e:.3f}" if np.isfinite(e) and e > 0 else "") for v, e in zip(u, se)))
+            _pct(v) + (f" ± {_pct(2 * e)}" if np.isfinite(e) and e > 0 else "") for v, e in zip(u, se)))
     if n == 0:
         return Verdict(claim, "no data", "no finished run", [], [])
     if below == n and toe_largest == n:
