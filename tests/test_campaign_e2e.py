@@ -68,8 +68,10 @@ def test_report_has_every_section(campaign):
                 "Stability", "Configuration", "Provenance")
     assert [html.index(f"<h2>{s}</h2>") for s in sections] == sorted(html.index(f"<h2>{s}</h2>") for s in sections)
     assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
-    from study.figures import FIGURES
-    assert html.count("data:image/png;base64,") == len(FIGURES) == 12  # Figs. 2-13
+    from study.config import load
+    from study.figures import figures_for
+    assert html.count("data:image/png;base64,") == len(figures_for(load(MINI))) == 11  # Figs. 2-12
+    assert "Where the plug is" not in html  # a Newtonian campaign: no plug map
     # the forced divergence is counted and named in the stability section and map
     assert "1 diverged, 1 of them stopped by a named detector (1 density deviation)" in html
     assert "http://" not in html and "https://" not in html  # opens offline
@@ -83,7 +85,7 @@ def test_report_in_a_real_browser(campaign):
         pytest.skip("no Chromium (Debian: apt-get install chromium); .ci/run installs it")
     r = check_report(campaign / "reports" / "report.html", screenshot=campaign / "first_screen.png")
     assert r.ok, (r.broken, r.external)
-    assert len(r.images) == 12 and r.title == "sph-surge campaign report"
+    assert len(r.images) == 11 and r.title == "sph-surge campaign report"
 
 
 def test_figure_settings_do_not_rerun_simulations(campaign, tmp_path):
@@ -105,14 +107,17 @@ def test_finished_cases_are_not_recomputed(campaign):
 
 
 def test_snakemake_report_takes_the_registered_captions(campaign):
-    """``snakemake --report`` packages every registered figure with its caption."""
+    """``snakemake --report`` packages every figure the campaign draws with its caption, and
+    not the plug map of a Newtonian campaign."""
     import zipfile
-    from study.figures import FIGURES
+    from study.config import load
+    from study.figures import FIGURES, figures_for
     p = snakemake(campaign, MINI, "--report", "report.zip")
     assert p.returncode == 0, p.stderr[-4000:]
     with zipfile.ZipFile(campaign / "report.zip") as z:
         names = z.namelist()
         text = "".join(z.read(n).decode("utf-8", "replace") for n in names if n.endswith((".html", ".js")))
+    drawn = figures_for(load(MINI))
     for spec in FIGURES:
-        assert any(n.endswith(f"{spec.name}.png") for n in names), spec.name
+        assert any(n.endswith(f"{spec.name}.png") for n in names) == (spec in drawn), spec.name
     assert "Pareto front (no case is both cheaper and more accurate)" in text

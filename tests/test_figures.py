@@ -85,3 +85,92 @@ def test_every_caption_reads_as_plain_restructured_text():
         tree = publish_doctree(spec.caption_rst(1.8), settings_overrides={"report_level": 5, "halt_level": 5})
         assert not list(tree.findall(system_message)), spec.name
         assert tree.astext().strip() == f"{spec.title}. {spec.full_caption(1.8)}", spec.name
+
+
+def _config(name, **changes):
+    import yaml
+    from pathlib import Path
+
+    from study.config import validate
+    cfg = yaml.safe_load((Path(__file__).resolve().parent.parent / "config" / name).read_text())
+    return validate({**cfg, **changes})
+
+
+def test_the_plug_map_is_drawn_only_for_a_campaign_with_a_yield_stress_case():
+    """figures_for (the rules' outputs and both reports): a Newtonian campaign has no plug map,
+    a Herschel-Bulkley one has it, and so has a Newtonian grid with one Herschel-Bulkley extra
+    case; every other figure is drawn for all three."""
+    hb = {"rheology": "herschel_bulkley", "density": 1000.0, "yield_stress": 20.0, "consistency": 10.0,
+          "index": 0.4, "max_viscosity": 100.0}
+    newtonian = _config("config.yaml")
+    mixed = _config("config.yaml", extra_cases=[{"dp": 2.25e-3, "ch": 1.8, "shifting": "lind", "tag": "hb",
+                                                 "overrides": hb}])
+    others = [n for n in figures.FIGURE_NAMES if n != "fig13_plug_map"]
+    assert [s.name for s in figures.figures_for(newtonian)] == others
+    for cfg in (_config("viscoplastic.yaml"), mixed):
+        assert [s.name for s in figures.figures_for(cfg)] == list(figures.FIGURE_NAMES)
+
+
+def test_a_newtonian_campaign_neither_draws_nor_reports_the_plug_map(tmp_path):
+    """python -m study figures and report, as the rules call them, on a Newtonian campaign
+    dataset: no plug-map file, and the HTML report neither shows nor names it."""
+    import yaml
+
+    from study.cli import main
+    ds = campaign(metric, steady=lambda dp, ch, sh: dp > 0.001)
+    ds.to_netcdf(tmp_path / "campaign.nc")
+    cfg = _config("config.yaml")
+    cfg["figures"]["dpi"] = 50
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(cfg))
+    out = tmp_path / "figures"
+    assert main(["figures", str(tmp_path / "config.yaml"), str(tmp_path / "campaign.nc"), "-o", str(out)]) == 0
+    drawn = sorted(p.stem for p in out.iterdir())
+    assert drawn == sorted(n for n in figures.FIGURE_NAMES if n != "fig13_plug_map")
+    report = tmp_path / "report.html"
+    assert main(["report", str(tmp_path / "config.yaml"), str(tmp_path / "campaign.nc"), "--figures", str(out),
+                 "-o", str(report)]) == 0
+    text = report.read_text()
+    assert text.count("<figure ") == len(drawn)
+    assert "fig13_plug_map" not in text and "Where the plug is" not in text
+    plt.close("all")
+
+
+def _tick_labels(axis):
+    """Every label of the major and minor ticks in view, and the axis's offset text."""
+    lo, hi = sorted(axis.get_view_interval())
+    labels = [t.get_text() for minor in (False, True) for t in axis.get_ticklabels(minor=minor)
+              if t.get_text() and lo <= t.get_position()[axis.axis_name == "y"] <= hi]
+    return labels + [axis.get_offset_text().get_text()]
+
+
+def test_every_axis_of_every_figure_has_plain_tick_labels():
+    """Run times within a factor 2 (30 to 60 s: matplotlib labels a log axis spanning less than
+    a decade at its minor ticks, as 3x10^1) and errors within one decade: every tick label of
+    every figure is a plain number, errors in per cent; no mathtext, no offset."""
+    ds = campaign(metric, steady=lambda dp, ch, sh: dp > 0.001)
+    ds["wall_time"][:] = np.linspace(30, 60, ds["wall_time"].size).reshape(ds["wall_time"].shape)
+    z = np.linspace(0, 1, 11)
+    theory = xr.Dataset({"velocity": (("station", "z_star"), np.tile(1.5 * z, (STATIONS.size, 1)))},
+                        coords={"station": STATIONS, "z_star": z})
+    settings = figures.Settings(1.8, theory)
+    for spec in figures.FIGURES:
+        with plt.rc_context(figures.STYLE):
+            fig = spec.draw(ds, settings)
+            fig.canvas.draw()
+        for ax in fig.axes:
+            for axis in (ax.xaxis, ax.yaxis):
+                for label in _tick_labels(axis):
+                    assert not any(m in label for m in ("$", "10^", "times", "×", "e+", "e-")), (spec.name, label)
+                if axis.get_scale() == "log" and axis.axis_name == "y":  # the errors
+                    assert all(t.endswith(" %") for t in _tick_labels(axis)[:-1]), spec.name
+        if spec.name == "fig11_cost_vs_error":
+            wall = _tick_labels(fig.axes[0].xaxis)
+            assert {"30", "40", "60"} <= set(wall), wall
+            assert set(_tick_labels(fig.axes[0].yaxis)) >= {"1 %", "2 %", "3 %"}
+        plt.close(fig)
+
+
+def test_no_gci_band_from_an_observed_order_above_4():
+    dp = np.array([0.004, 0.002, 0.001])
+    assert np.isnan(figures._gci_band(dp, 0.02 + 0.01 * (dp / 0.001) ** 6))
+    assert figures._gci_band(dp, 0.02 + 0.01 * (dp / 0.001) ** 3) > 0

@@ -27,27 +27,42 @@ def test_the_report_opens_with_the_verdict():
 
 def test_the_case_table_gives_the_metrics_with_their_sampling_error():
     """zeta_f is shown as value +- 2 se where the run carries its standard error, alone where
-    it does not (metrics written before the error was kept)."""
+    it does not (metrics written before the error was kept); both in per cent to two
+    significant digits."""
     from study.report import case_table
     ds = campaign(paper_like)
     ds["case_zeta_f"][:] = 0.0077
     ds["case_zeta_f_se"] = xr.full_like(ds["case_zeta_f"], 0.0105)
     ds["case_zeta_f_se"][0] = np.nan
     table = case_table(ds)
-    assert table.count("0.0077 &plusmn; 0.021") == ds.sizes["case"] - 1
-    assert "zeta_f (± 2 se)" in table
+    assert table.count("0.77 % &plusmn; 2.1 %") == ds.sizes["case"] - 1
+    assert table.count("<td>0.77 %</td>") == 1
+    assert "zeta_f [%] (± 2 se)" in table
     # the front body's error beside it; a dash where the metrics predate it
     dashes = table.count("<td>&ndash;</td>")
     ds["case_zeta_f_body"] = xr.full_like(ds["case_zeta_f"], 0.00357)
     ds["case_zeta_f_body_se"] = xr.full_like(ds["case_zeta_f"], 0.000105)
     table = case_table(ds)
-    assert table.count("0.00357 &plusmn; 0.00021") == ds.sizes["case"]
+    assert table.count("0.36 % &plusmn; 0.021 %") == ds.sizes["case"]
     assert dashes - table.count("<td>&ndash;</td>") == ds.sizes["case"]
-    # zeta_u's jackknife error, in plain decimals to two digits
+    # zeta_u's jackknife error
     ds["case_zeta_u"][:] = 0.0159
     ds["case_zeta_u_se"] = xr.full_like(ds["case_zeta_u"], 0.00029)
     table = case_table(ds)
-    assert table.count("0.0159 &plusmn; 0.00058") == ds.sizes["case"] * ds.sizes["station"]
+    assert table.count("1.6 % &plusmn; 0.058 %") == ds.sizes["case"] * ds.sizes["station"]
+    assert "zeta_u x*=0.76 [%] (± 2 se)" in table
+    # the two the case table mixed as 4.537e-04 ± 0.0016 and 0.0816 ± 0.015
+    ds["case_zeta_fs"][:2] = [4.537e-4, 0.0816]
+    ds["case_zeta_fs_se"] = ("case", [0.0008, 0.0075] + [np.nan] * (ds.sizes["case"] - 2))
+    table = case_table(ds)
+    assert "<td>0.045 % &plusmn; 0.16 %</td>" in table and "<td>8.2 % &plusmn; 1.5 %</td>" in table
+
+
+def test_an_error_reads_in_per_cent_to_two_significant_digits():
+    from study.numbers import percent
+    assert [percent(v) for v in (4.537e-4, 0.0016, 0.0816, 0.015, 0.01, 1.234, 0.0)] == [
+        "0.045 %", "0.16 %", "8.2 %", "1.5 %", "1 %", "120 %", "0 %"]
+    assert percent(np.nan) == "-" and percent(np.inf, "&ndash;") == "&ndash;"
 
 
 def test_the_case_table_gives_the_acoustic_cfl_each_run_used():
@@ -114,7 +129,7 @@ def test_an_ensemble_campaign_says_what_its_grid_values_and_errors_are():
     assert "realisation k's steady.min_time is raised by k &times; 0.25 s" in render(ds, [], "grid: {}")
     n_points = ds["wall_time"].size
     assert f"{ds.sizes['case']} cases ({n_points} grid points; every grid case ran in 3 realisations)" in text
-    assert "cheapest steady grid point &le; 0.01" in text
+    assert "cheapest steady grid point &le; 1 %" in text
 
 
 def test_an_ensemble_of_different_sizes_names_its_grid_points_by_count():
@@ -148,3 +163,51 @@ def test_the_verdict_section_says_what_the_runs_start_from_and_which_scheme_they
     ds.attrs.update(schemes="spec", starts=start_description(paper))
     assert "a block at rest at the normal depth, the belt ramped up from rest; their scheme, spec, is the paper's" \
         in html.unescape(verdict_table(ds))
+
+
+def test_the_convergence_table_lists_only_the_sequences_that_have_data():
+    """The default campaign runs Lind at Ch 1.8 only: its excluded (Ch, shifting) sequences,
+    with no value at any dp, get no rows; a sequence with data gets one row per quantity."""
+    from study.report import convergence_table
+    ds = campaign(paper_like)
+    for ch in (1.5, 2.2):  # as the campaign dataset holds the grid's excluded points
+        sel = dict(ch=ch, shifting="lind")
+        ds["uniform_depth"].loc[sel] = np.nan
+        ds["mean_velocity"].loc[sel] = np.nan
+        ds["status"].loc[sel] = "missing"
+    table = convergence_table(ds)
+    rows = table.count("<tr><td")
+    assert rows == 4 * (1 + STATIONS.size)  # skillen at three Ch, lind at 1.8; h_u and u* per station
+    assert '<td class="l">lind</td><td>1.8</td>' in table
+    for ch in ("1.5", "2.2"):
+        assert f'<td class="l">lind</td><td>{ch}</td>' not in table
+        assert f'<td class="l">skillen</td><td>{ch}</td>' in table
+    ds["uniform_depth"][:] = np.nan
+    ds["mean_velocity"][:] = np.nan
+    assert "<table>" not in convergence_table(ds)
+
+
+def test_an_observed_order_above_4_is_flagged_and_not_extrapolated():
+    """zeta_f and the uniform depth of order 6 over dp (4, 2, 1 mm): the accuracy table and the
+    convergence table show the order, flagged unreliable, and no limit, band, GCI or dp from it;
+    first-order metrics keep theirs."""
+    from study.report import accuracy_table, convergence_table
+
+    def steep(name, dp, ch, sh):
+        if name in ("zeta_f", "zeta_h"):
+            return 0.02 + 0.01 * (dp / 0.001) ** 6
+        return paper_like(name, dp, ch, sh)
+    ds = campaign(steep)
+    table = accuracy_table(ds)
+    zeta_f = table[table.index(">zeta_f<"):table.index(">zeta_h<")]
+    assert zeta_f.count("not extrapolated: observed order p = 6, above 4 (unreliable)") == 2  # both methods
+    assert zeta_f.count("&ndash; (order above 4: unreliable)") == 2
+    assert "(p = 6)" not in table and "(p = 1)" in table  # zeta_fs, first order, is extrapolated
+    assert "an order above 4 is unreliable" in table
+    conv = convergence_table(ds)
+    depth = [row for row in conv.split("<tr>") if "h_u / h_n" in row]
+    assert len(depth) == ds.sizes["ch"] * ds.sizes["shifting"]
+    for row in depth:
+        cells = row.split("</td>")
+        assert cells[3].endswith("unreliable") and cells[4].endswith("6 (above 4: unreliable)")
+        assert all(c.endswith("&ndash;") for c in cells[5:8]), row

@@ -115,6 +115,30 @@ def test_extrapolation_and_the_dp_needed():
     assert math.isnan(x.dp_needed)  # not 1e-3 (0.4)^(1/0.3) = 47 um, nor any other dp
 
 
+def test_an_observed_order_above_4_is_unreliable_and_extrapolates_nothing():
+    """The yield-stress campaign's grid (dp 2.5, 2, 1.6 mm) and a sequence of order 15, as its
+    accuracy table showed: the order is kept, but no limit, band or dp comes from it; an order of
+    3.5 still extrapolates."""
+    dp = np.array([0.0025, 0.002, 0.0016])
+    x = extrapolate(dp, 0.0731 + 0.0005 * (dp / 0.0016) ** 15)
+    assert x.status == "unreliable" and x.order == pytest.approx(15.0)
+    assert math.isnan(x.extrapolated) and math.isnan(x.band) and math.isnan(x.dp_needed)
+    x = extrapolate(dp, 0.004 + 0.0005 * (dp / 0.0016) ** 15)  # already below 1 % at the finest dp
+    assert x.status == "unreliable" and x.dp_needed == 0.0016 and math.isnan(x.extrapolated)
+    x = extrapolate(dp, 0.0731 + 0.0005 * (dp / 0.0016) ** 3.5)
+    assert x.status == "monotone" and x.order == pytest.approx(3.5)
+    assert x.extrapolated == pytest.approx(0.0731) and x.band > 0 and x.dp_needed == math.inf
+
+
+def test_a_limit_from_an_unreliable_order_is_not_compared_with_5_percent():
+    def steep(name, dp, ch, sh):  # zeta_h_paper of order 6 at every Ch: decreasing, but unreliable
+        return 0.05 + 0.01 * (dp / 0.001) ** 6 if name == "zeta_h_paper" else paper_like(name, dp, ch, sh)
+    v = by_claim(campaign(steep))["zeta_h"]
+    assert v.verdict == "not reproduced"
+    assert "At Ch 1.8 the sequence is monotone at an observed order of 6, above 4: unreliable" in v.evidence
+    assert "Limit at" not in v.evidence
+
+
 def test_the_cheapest_run_under_a_threshold_honours_the_sampling_error():
     """zeta_f of the paper-like campaign (skillen 0.6-0.7 % and lind 0.3-0.35 % at dp = 1 mm,
     the only runs below 1 %): with 2 se = 0.2 % the cheapest run under 1 % is one of them; with
@@ -142,7 +166,7 @@ def test_the_accuracy_table_gives_the_finest_value_with_its_sampling_error():
     ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], 0.0015)
     rows = [r for r in accuracy_rows(ds) if r["metric"] == "zeta_f"]
     assert len(rows) == 2 and all(r["finest_two_se"] == pytest.approx(0.003) for r in rows)
-    assert accuracy_table(ds).count("&plusmn; 0.003<") == 2
+    assert accuracy_table(ds).count("&plusmn; 0.3 %<") == 2  # in per cent, as the value
     ds["zeta_f_se"] = xr.full_like(ds["zeta_f"], np.nan)
     assert accuracy_table(ds).count("&plusmn; (se unknown)") == 2
 
@@ -194,14 +218,15 @@ def test_a_zeta_f_whose_sampling_error_is_unknown_decides_nothing():
 def test_a_zeta_u_difference_within_its_sampling_error_does_not_contradict():
     """The opposite campaign: lind's zeta_u is 3x skillen's, at dp = 1 mm 0.036 / 0.096 / 0.126
     against 0.012 / 0.032 / 0.042 (differences 0.024 / 0.064 / 0.084). With se = 0.001 a run
-    the marginal claim is contradicted and its evidence shows the 2 se of the difference; with
+    the marginal claim is contradicted and its evidence shows the 2 se of the difference (2
+    sqrt(2) 0.001), in per cent to two significant digits as the errors; with
     se = 0.03 (2 se of a difference 0.085) no difference exceeds 1 % of u_b by more than 2 se:
     not reproduced; nor with an unknown se."""
     ds = campaign(opposite)
     ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], 0.001)
     v = by_claim(ds)["marginal"]
     assert v.verdict == "contradicted"
-    assert "x* = 9.7: lind 0.126, skillen 0.042 (difference 0.084 ± 0.003, 2 se)" in v.evidence
+    assert "x* = 9.7: lind 13 %, skillen 4.2 % (difference 8.4 % ± 0.28 %, 2 se)" in v.evidence
     for se in (0.03, np.nan):
         ds["zeta_u_se"] = xr.full_like(ds["zeta_u"], se)
         assert by_claim(ds)["marginal"].verdict == "not reproduced"

@@ -1,8 +1,10 @@
-# The figures and captions come from one registry, study.figures.FIGURES.
+# The figures and captions come from one registry, study.figures.FIGURES: those this campaign
+# draws (figures_for: the plug map only with a Herschel-Bulkley case).
 import os
 
-from study.figures import FIGURES as FIGURE_SPECS
+from study.figures import figures_for
 
+FIGURE_SPECS = figures_for(config)
 FIGURES = [spec.name for spec in FIGURE_SPECS]
 FMT = config["figures"]["format"]
 CAPTIONS = os.path.abspath("results/report_captions")  # absolute: Snakemake resolves captions from this file's folder

@@ -110,19 +110,20 @@ def _figure_settings(cfg, ds):
 
 def cmd_figures(a):
     import xarray as xr
-    from .figures import write_all
+    from .figures import figures_for, write_all
     cfg = _cfg(a.config)
     f = cfg["figures"]
     with xr.open_dataset(a.campaign) as ds:
         ds = ds.load()
-    for p in write_all(ds, a.outdir, _figure_settings(cfg, ds), fmt=f["format"], dpi=f["dpi"]):
+    for p in write_all(ds, a.outdir, _figure_settings(cfg, ds), fmt=f["format"], dpi=f["dpi"],
+                       specs=figures_for(cfg)):
         print(p)
 
 
 def cmd_report(a):
     import xarray as xr
     import yaml
-    from .figures import FIGURES
+    from .figures import figures_for
     from .report import render, write
     cfg = _cfg(a.config)
     f = cfg["figures"]
@@ -130,7 +131,7 @@ def cmd_report(a):
         ds = ds.load()
     settings = _figure_settings(cfg, ds)
     figs = []
-    for spec in FIGURES:
+    for spec in figures_for(cfg):
         p = Path(a.figures) / f"{spec.name}.{f['format']}"
         if not p.exists():
             raise SystemExit(f"error: missing figure {p}; run the figures step first")

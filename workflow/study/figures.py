@@ -11,15 +11,19 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
+
+from .verdict import MAX_ORDER  # noqa: E402
 
 
 # Okabe-Ito palette
 COLOURS = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442", "#000000"]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
 STYLE = {"figure.dpi": 100, "axes.grid": True, "grid.alpha": 0.3, "font.size": 10,
-         "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False}
+         "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
+         "axes.formatter.useoffset": False}  # linear axes: each tick its own plain number
 
 
 @dataclass(frozen=True)
@@ -32,12 +36,14 @@ class Settings:
 @dataclass(frozen=True)
 class FigureSpec:
     """One figure of the report: its file name, title, caption and drawing function.
-    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note."""
+    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note; ``when``,
+    given the validated campaign config, says whether the campaign draws it (None: always)."""
     name: str
     title: str
     caption: str
     draw: Callable[[xr.Dataset, Settings], object]
     hollow: bool = False
+    when: Callable[[dict], bool] | None = None
 
     def full_caption(self, profile_ch: float) -> str:
         return self.caption.format(ch=profile_ch) + (HOLLOW if self.hollow else "")
@@ -60,20 +66,21 @@ def _dp_mm(ds):
 def _log_axes(ax, any_data: bool, xlabel: str = "particle spacing dp [mm]", invert_x: bool = True,
               dp_ticks=None):
     """Log axes when something was drawn (dp axes run coarse to fine, left to right, ticked
-    at the campaign's dp values in plain numbers); otherwise say there is nothing to draw."""
+    at the campaign's dp values), every tick label a plain number (the y axis, an error, in per
+    cent); otherwise say there is nothing to draw."""
     from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
     if any_data:
         ax.set_xscale("log")
         ax.set_yscale("log")
         if invert_x:
             ax.invert_xaxis()
+        ax.xaxis.set_major_formatter(FuncFormatter(_plain))
+        ax.xaxis.set_minor_formatter(_PlainLogFormatter(_plain))
         if dp_ticks is not None:
             ax.xaxis.set_major_locator(FixedLocator(np.asarray(dp_ticks, dtype=float)))
             ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.xaxis.set_major_formatter(FuncFormatter(_plain))
-        ax.yaxis.set_major_formatter(FuncFormatter(_plain))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _plain(v) if _few_decades(ax)
-                                                   and _mantissa(v) in (2, 3, 5) else ""))
+        ax.yaxis.set_major_formatter(FuncFormatter(_percent_tick))
+        ax.yaxis.set_minor_formatter(_PlainLogFormatter(_percent_tick))
     else:
         ax.text(0.5, 0.5, "no run gave this metric\n(diverged)", transform=ax.transAxes,
                 ha="center", va="center", color="0.4")
@@ -85,13 +92,21 @@ def _plain(v, _pos=None) -> str:
     return f"{v:.4g}" if 1e-4 <= abs(v) < 1e5 else f"{v:.0e}"
 
 
-def _mantissa(v: float) -> int:
-    return round(v / 10 ** np.floor(np.log10(v))) if v > 0 else 0
+def _percent_tick(v, _pos=None) -> str:
+    """A tick label of an error (a fraction) in per cent: 0.005 -> '0.5 %', 0.02 -> '2 %'."""
+    return f"{_plain(100.0 * v)} %"
 
 
-def _few_decades(ax) -> bool:
-    lo, hi = sorted(ax.get_ylim())
-    return lo > 0 and hi / lo < 12  # label minor ticks where a decade has no major one
+class _PlainLogFormatter(matplotlib.ticker.LogFormatter):
+    """The minor ticks of a log axis that matplotlib labels (on an axis spanning about a decade
+    or less: some or all of 2-9 times a power of ten, which it writes 3x10^1), written by
+    ``text`` instead: plain numbers."""
+    def __init__(self, text):
+        super().__init__(labelOnlyBase=False)
+        self.text = text
+
+    def __call__(self, x, pos=None):
+        return self.text(x) if super().__call__(x, pos) else ""
 
 
 def _legend(axes, steadiness: bool = True, **kw):
@@ -178,9 +193,10 @@ def _metric_figure(ds, var, ylabel):
 HOLLOW = (" Filled markers: metrics over a steady window; hollow markers: over the final window "
           "of a run that did not reach steady state (read them as indicative only). Error bars on "
           "the finest dp: the GCI band of that value (Celik et al. 2008), where the three finest "
-          "dp converge monotonically; on the log axis a band that reaches zero is drawn down to "
-          "5 % of the value. Thin bars without caps: +- 2 standard errors of each run's sampling "
-          "error over its averaging window, the same error the verdicts use.")
+          f"dp converge monotonically at an observed order of at most {MAX_ORDER:g}; on the log "
+          "axis a band that reaches zero is drawn down to 5 % of the value. Thin bars without "
+          "caps: +- 2 standard errors of each run's sampling error over its averaging window, the "
+          "same error the verdicts use.")
 
 
 def fig_velocity_profiles(ds, ch, ref):
@@ -256,9 +272,16 @@ def fig_plug_map(ds, ch):
             ax.legend(fontsize=7, loc="upper right")  # above the toe, where there is no fluid
             ax.set_aspect("equal")
         else:
-            ax.text(0.5, 0.5, "no yield stress in this campaign (or no final state)",
+            ax.text(0.5, 0.5, "no yield stress in this run (or no final state)",
                     transform=ax.transAxes, ha="center", va="center", color="0.4")
     return _front_panels(ds, ch, draw)
+
+
+def has_yield_stress(config: dict) -> bool:
+    """Whether any case of the validated campaign config, grid or extra, runs a yield-stress
+    (Herschel-Bulkley) fluid: the plug map's condition."""
+    from .config import cases, solver_case
+    return any(not solver_case(config, c).newtonian for c in cases(config))
 
 
 def fig_shifting_comparison(ds, var, ch, station_panels=False):
@@ -443,19 +466,27 @@ FIGURES = (
     FigureSpec("fig13_plug_map", "Where the plug is",
                "For a Herschel-Bulkley fluid: the final fluid particles within 3 h_n of the toe "
                "at the finest dp and Ch = {ch:g}, yielded (viscosity below the cap max_viscosity) "
-               "or unyielded (at the cap: the plug). Not in the paper; empty for a Newtonian "
-               "campaign.",
-               lambda ds, st: fig_plug_map(ds, st.profile_ch)),
+               "or unyielded (at the cap: the plug). Not in the paper; drawn only for a campaign "
+               "with a Herschel-Bulkley case.",
+               lambda ds, st: fig_plug_map(ds, st.profile_ch), when=has_yield_stress),
 )
 FIGURE_NAMES = tuple(f.name for f in FIGURES)
 
 
-def write_all(ds: xr.Dataset, outdir, settings: Settings, fmt: str = "png", dpi: int = 120) -> list[Path]:
-    """Draw every registered figure into outdir/<name>.<fmt> (each written atomically)."""
+def figures_for(config: dict) -> tuple[FigureSpec, ...]:
+    """The registered figures that the campaign of ``config`` (validated: study.config.validate)
+    draws: the rules' outputs, Snakemake's report and the HTML report take these."""
+    return tuple(spec for spec in FIGURES if spec.when is None or spec.when(config))
+
+
+def write_all(ds: xr.Dataset, outdir, settings: Settings, fmt: str = "png", dpi: int = 120,
+              specs=FIGURES) -> list[Path]:
+    """Draw the figures ``specs`` (default: every registered one) into outdir/<name>.<fmt>
+    (each written atomically)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     paths = []
-    for spec in FIGURES:
+    for spec in specs:
         with plt.rc_context(STYLE):
             fig = spec.draw(ds, settings)
         p = outdir / f"{spec.name}.{fmt}"

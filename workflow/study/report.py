@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from .campaign import ensemble_size
+from .numbers import percent
 
 CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;
@@ -52,19 +53,19 @@ def _commit() -> str:
 
 
 def _with_error(value, se) -> str:
-    """value +- 2 se (its sampling error), or the value alone where se is unknown."""
+    """An error (a fraction) in per cent +- 2 se (its sampling error), both to two significant
+    digits, or the value alone where se is unknown."""
     if se is None or not np.isfinite(se) or not np.isfinite(value):
-        return _fmt(value)
-    two_se = np.format_float_positional(2.0 * se, precision=2, unique=False, fractional=False, trim="-")
-    return f"{_fmt(value)} &plusmn; {two_se}"
+        return percent(value, "&ndash;")
+    return f"{percent(value)} &plusmn; {percent(2.0 * se)}"
 
 
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
     head = ["case", "status", "steady", "wall time [s]", "steps", "C_CFL used", "particles", "steady at [s]",
-            "zeta_f (± 2 se)", "zeta_f of the front's body (± 2 se)", "zeta_h (h_n, ± 2 se)",
-            "zeta_h (paper, ± 2 se)", "zeta_fs (± 2 se)"] + [
-                f"zeta_u x*={s:g} (± 2 se)" for s in st]
+            "zeta_f [%] (± 2 se)", "zeta_f of the front's body [%] (± 2 se)", "zeta_h [%] (h_n, ± 2 se)",
+            "zeta_h [%] (paper, ± 2 se)", "zeta_fs [%] (± 2 se)"] + [
+                f"zeta_u x*={s:g} [%] (± 2 se)" for s in st]
     head.append("hold-out: metrics that moved by more than 2 se")
     rows = []
     for i, cid in enumerate(ds["case"].values):
@@ -95,7 +96,8 @@ def holdout_note(ds: xr.Dataset, i: int) -> str:
     if "case_zeta_h_holdout" not in ds or not np.isfinite(ds["case_zeta_h_holdout"].values[i]):
         return "no hold-out"
     moves = holdout_moves(ds, i)
-    return "; ".join(f"{html.escape(k)} {d:+.2g} (2 se {2 * e:.2g})" for k, d, e in moves) or "none"
+    return "; ".join(f"{html.escape(k)} {'+' if d > 0 else ''}{percent(d)} (2 se {percent(2 * e)})"
+                     for k, d, e in moves) or "none"
 
 
 def start_check_section(ds: xr.Dataset) -> str:
@@ -133,8 +135,10 @@ def start_check_section(ds: xr.Dataset) -> str:
 
 def convergence_table(ds: xr.Dataset) -> str:
     """Observed order, Richardson-extrapolated value and GCI of the uniform depth h_u/h_n and
-    of the station depth-mean u*, for each Ch and shifting with three or more resolutions."""
+    of the station depth-mean u*, for each Ch and shifting with three or more resolutions: the
+    (Ch, shifting) sequences that have data (a grid's excluded or wholly diverged ones do not)."""
     from .convergence import gci
+    from .verdict import MAX_ORDER
     if ds.sizes["dp"] < 3:
         return "<p>Fewer than three resolutions: no observed order or GCI.</p>"
     st = ds["station"].values
@@ -146,18 +150,28 @@ def convergence_table(ds: xr.Dataset) -> str:
             with np.errstate(all="ignore"):
                 means = np.nanmean(sub["mean_velocity"].values, axis=2)
             quantities += [(f"mean u* at x* = {s:g}", means[:, j]) for j, s in enumerate(st)]
+            if not any(np.isfinite(phi).any() for _, phi in quantities):
+                continue  # never run, or every run diverged: no sequence to judge
             for name, phi in quantities:
                 r = gci(sub["dp"].values, phi)
+                order = _fmt(r.order)
+                if r.status == "monotone" and r.order > MAX_ORDER:  # its order alone, flagged
+                    order += f" (above {MAX_ORDER:g}: unreliable)"
+                    r = type(r)("unreliable", r.order)
                 rows.append(f'<tr><td class="l">{html.escape(str(sh))}</td><td>{ch:g}</td>'
                             f'<td class="l">{html.escape(name)}</td><td class="l">{r.status}</td>'
-                            f"<td>{_fmt(r.order)}</td><td>{_fmt(r.extrapolated, 4)}</td>"
-                            f"<td>{_fmt(r.gci_fine)}</td><td>{_fmt(r.error_fine)}</td></tr>")
+                            f"<td>{order}</td><td>{_fmt(r.extrapolated, 4)}</td>"
+                            f"<td>{percent(r.gci_fine, '&ndash;')}</td>"
+                            f"<td>{percent(r.error_fine, '&ndash;')}</td></tr>")
+    if not rows:
+        return "<p>No run finished: no observed order or GCI.</p>"
     head = ("<tr><th class='l'>shifting</th><th>Ch</th><th class='l'>quantity</th>"
             "<th class='l'>sequence</th><th>observed order</th><th>extrapolated</th>"
-            "<th>GCI fine</th><th>finest vs extrapolated</th></tr>")
+            "<th>GCI fine [%]</th><th>finest vs extrapolated [%]</th></tr>")
     return ("<p>Grid Convergence Index (Celik et al. 2008) over the three finest resolutions; "
-            "oscillatory or divergent sequences are flagged and given no number. Runs that were "
-            "not steady enter with their final-window values.</p>"
+            "oscillatory or divergent sequences are flagged and given no number, and a monotone one "
+            f"whose observed order is above {MAX_ORDER:g} is flagged unreliable and given its order "
+            "alone. Runs that were not steady enter with their final-window values.</p>"
             f"<table>{head}{''.join(rows)}</table>")
 
 
@@ -208,7 +222,7 @@ def verdict_table(ds: xr.Dataset) -> str:
 def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
     """Per metric: the cheapest steady run under each threshold, and per shifting method at
     the paper's Ch the GCI-extrapolated value, its band and the dp needed for 1 %."""
-    from .verdict import MIN_ORDER, accuracy_rows
+    from .verdict import MAX_ORDER, MIN_ORDER, accuracy_rows
     rows = accuracy_rows(ds, thresholds)
     out, last = [], None
     for r in rows:
@@ -217,31 +231,36 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
         cells = [f'<td class="l">{html.escape(r["metric"]) if first else ""}</td>']
         for thr in thresholds:
             c = r["cheapest"][thr]
-            txt = "none" if c is None else (f"{c[0]} ({c[1]:.0f} s, {c[2]:.3g}"
-                                            + ("" if c[3] is None else f" ± {c[3]:.2g}") + ")")
+            txt = "none" if c is None else (f"{c[0]} ({c[1]:.0f} s, {percent(c[2])}"
+                                            + ("" if c[3] is None else f" ± {percent(c[3])}") + ")")
             cells.append(f'<td class="l">{html.escape(txt) if first else ""}</td>')
         x = r["extrapolation"]
         if x.status == "monotone":
-            lim = f"{_fmt(x.extrapolated)} &plusmn; {_fmt(x.band, 2)} (p = {x.order:.2g})"
+            lim = f"{percent(x.extrapolated)} &plusmn; {percent(x.band)} (p = {x.order:.2g})"
             need = (f"&ndash; (order below {MIN_ORDER:g}: not converging yet)" if np.isnan(x.dp_needed)
                     else "never (limit above 1 %)" if not np.isfinite(x.dp_needed)
                     else f"{x.dp_needed * 1000:.3g} mm")
+        elif x.status == "unreliable":
+            lim = f"not extrapolated: observed order p = {x.order:.2g}, above {MAX_ORDER:g} (unreliable)"
+            need = (f"{x.dp_needed * 1000:.3g} mm" if np.isfinite(x.dp_needed)
+                    else f"&ndash; (order above {MAX_ORDER:g}: unreliable)")
         else:
             lim, need = html.escape(x.status), "&ndash;"
         two_se = r["finest_two_se"]
-        finest = _fmt(x.finest) + ("" if two_se == 0 or not np.isfinite(x.finest)
-                                   else " &plusmn; (se unknown)" if not np.isfinite(two_se)
-                                   else f" &plusmn; {two_se:.2g}")
+        finest = percent(x.finest, "&ndash;") + ("" if two_se == 0 or not np.isfinite(x.finest)
+                                                 else " &plusmn; (se unknown)" if not np.isfinite(two_se)
+                                                 else f" &plusmn; {percent(two_se)}")
         cells += [f'<td class="l">{html.escape(r["shifting"])}</td>', f"<td>{finest}</td>",
                   f'<td class="l">{lim}</td>', f'<td class="l">{need}</td>']
         out.append("<tr>" + "".join(cells) + "</tr>")
     ch = rows[0]["ch"] if rows else float("nan")
     ensemble = ensemble_size(ds) > 1
     unit = "grid point" if ensemble else "run"
-    head = ("<tr><th class='l'>metric</th>" + "".join(f"<th class='l'>cheapest steady {unit} &le; {t:g}</th>"
-                                                     for t in thresholds)
-            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp &plusmn; 2 se</th>"
-            "<th class='l'>GCI limit dp &rarr; 0 &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
+    head = ("<tr><th class='l'>metric</th>"
+            + "".join(f"<th class='l'>cheapest steady {unit} &le; {percent(t)}</th>"
+                      for t in thresholds)
+            + f"<th class='l'>shifting (Ch {ch:g})</th><th>finest dp [%] &plusmn; 2 se</th>"
+            "<th class='l'>GCI limit dp &rarr; 0 [%] &plusmn; band</th><th class='l'>dp for 1 %</th></tr>")
     what = ("grid point (a realisation's mean wall time, the realisations' mean error and the ensemble's se)"
             if ensemble else "run (wall time, error)")
     return (f"<p>The cheapest steady {what} meeting each threshold over the whole "
@@ -249,7 +268,8 @@ def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
             "Ch, the metric at the finest dp, its Richardson limit with the GCI band of the finest "
             "value (Celik et al. 2008; only for monotone sequences over the three finest dp) and "
             "the dp at which zeta = limit + C dp^p reaches 1 % (not projected from an observed "
-            f"order p below {MIN_ORDER:g}).</p>"
+            f"order p below {MIN_ORDER:g}; an order above {MAX_ORDER:g} is unreliable, and neither "
+            "limit, band nor dp is extrapolated from it).</p>"
             f"<table>{head}{''.join(out)}</table>")
 
 

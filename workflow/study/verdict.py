@@ -27,12 +27,17 @@ import xarray as xr
 
 from .campaign import ensemble_size
 from .convergence import gci
+from .numbers import percent
 
 PAPER_CH = 1.8
 PAPER_FINEST_DP = 0.25e-3
 RESOLVED = 0.10  # a difference between two runs below this fraction of the larger is a tie
 # an observed order below this is no asymptotic convergence: no dp is projected from it
 MIN_ORDER = 0.5
+# an observed order above this is unreliable: three values whose differences happen to shrink
+# fast, not convergence; r21^p so large would shrink the GCI band to nothing. Nothing is
+# extrapolated from it (no limit, no band, no dp projected)
+MAX_ORDER = 4.0
 MARGINAL_U = 0.01  # |delta zeta_u| below which shifting "marginally" affects zeta_u (1 % of u_b)
 
 
@@ -47,14 +52,16 @@ class Verdict:
 
 @dataclass
 class Extrapolation:
-    """GCI over the three finest dp of one metric sequence, and what it implies."""
+    """GCI over the three finest dp of one metric sequence, and what it implies. ``status``:
+    study.convergence's, or ``unreliable`` for a monotone sequence whose observed order is above
+    MAX_ORDER (the order is kept; nothing is extrapolated)."""
     status: str
     finest: float = math.nan
     extrapolated: float = math.nan
     band: float = math.nan  # absolute uncertainty of the finest value: GCI_fine |finest|
     order: float = math.nan
     dp_needed: float = math.nan  # dp [m] at which the metric reaches the target; inf: never;
-    # NaN: not projected (an order below MIN_ORDER)
+    # NaN: not projected (an order below MIN_ORDER or above MAX_ORDER)
 
 
 def main_method(ds: xr.Dataset) -> str:
@@ -78,7 +85,9 @@ def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
     """GCI of a metric over dp; the dp at which phi(dp) = phi_ext + C dp^p reaches ``target``.
     The metrics are errors, never negative: a negative Richardson limit is reported as 0. An
     observed order below MIN_ORDER is not projected (dp_needed NaN): such a sequence is not in
-    its asymptotic range, and dp^p with p near 0 would put the target at absurdly small dp."""
+    its asymptotic range, and dp^p with p near 0 would put the target at absurdly small dp. An
+    order above MAX_ORDER is unreliable (status ``unreliable``): no limit, no band and no
+    projected dp; dp_needed is the finest dp only where that already meets the target."""
     dp = np.asarray(dp, dtype=float)
     phi = np.asarray(phi, dtype=float)
     ok = np.isfinite(dp) & np.isfinite(phi)
@@ -89,6 +98,11 @@ def extrapolate(dp, phi, target: float = 0.01) -> Extrapolation:
     r = gci(dp, phi)
     out = Extrapolation(r.status, finest=float(phi[i1]))
     if r.status != "monotone":
+        return out
+    if r.order > MAX_ORDER:
+        out.status, out.order = "unreliable", r.order
+        if out.finest <= target:
+            out.dp_needed = float(dp[i1])
         return out
     out.extrapolated, out.order = max(r.extrapolated, 0.0), r.order
     out.band = r.gci_fine * abs(out.finest)
@@ -129,7 +143,7 @@ def _finest_dp(da: xr.DataArray):
 
 
 def _pct(v):
-    return "-" if not np.isfinite(v) else f"{100 * v:.2g} %"
+    return percent(v)
 
 
 def _mm(dp):
@@ -245,7 +259,9 @@ def converging_claim(ds, var, chs, sh, claim, about=None):
         x = extrapolate(da["dp"].values, da.values)
         if x.status != "monotone":
             verdict = "not reproduced"
-            evidence += f". At Ch {ch:g} the sequence is {x.status}: no limit to compare with {_pct(value)}"
+            how = (f"monotone at an observed order of {x.order:.2g}, above {MAX_ORDER:g}: unreliable"
+                   if x.status == "unreliable" else x.status)
+            evidence += f". At Ch {ch:g} the sequence is {how}: no limit to compare with {_pct(value)}"
         else:
             lo, hi = x.extrapolated - x.band, x.extrapolated + x.band
             evidence += f". Limit at Ch {ch:g}: {_pct(x.extrapolated)} ± {_pct(x.band)}"
@@ -324,8 +340,8 @@ def marginal_shifting_claim(ds, claim):
         elif max(lv, sv) > 2 * min(lv, sv) and diff - two_se > MARGINAL_U:
             large += 1
         noise = "" if two_se == 0 else (" (difference ± 2 se unknown)" if not np.isfinite(two_se)
-                                        else f" (difference {diff:.3f} ± {two_se:.3f}, 2 se)")
-        parts.append(f"x* = {x:g}: lind {lv:.3f}, skillen {sv:.3f}{noise}")
+                                        else f" (difference {_pct(diff)} ± {_pct(two_se)}, 2 se)")
+        parts.append(f"x* = {x:g}: lind {_pct(lv)}, skillen {_pct(sv)}{noise}")
     verdict = ("reproduced" if marginal == st.size else "contradicted" if large else "not reproduced")
     evidence = f"Ch {ch:g}, dp = {_mm(dp)}: " + "; ".join(parts)
     sels = [dict(dp=dp, ch=ch, shifting=s) for s in ("lind", "skillen")]
@@ -357,7 +373,7 @@ def velocity_claim(ds, claim):
         toe_smallest += bool(others.size and np.all(u[others] - u[toe] > gap))
         sels.append(dict(dp=dp, ch=float(ch), shifting=sh))
         parts.append(f"Ch {ch:g} at {_mm(dp)}: " + ", ".join(
-            f"{v:.3f}" + (f" ± {2 * e:.3f}" if np.isfinite(e) and e > 0 else "") for v, e in zip(u, se)))
+            _pct(v) + (f" ± {_pct(2 * e)}" if np.isfinite(e) and e > 0 else "") for v, e in zip(u, se)))
     if n == 0:
         return Verdict(claim, "no data", "no finished run", [], [])
     if below == n and toe_largest == n:
