@@ -211,3 +211,35 @@ def test_an_observed_order_above_4_is_flagged_and_not_extrapolated():
         cells = row.split("</td>")
         assert cells[3].endswith("unreliable") and cells[4].endswith("6 (above 4: unreliable)")
         assert all(c.endswith("&ndash;") for c in cells[5:8]), row
+
+
+def start_check_campaign(shift: float) -> xr.Dataset:
+    """A case table of a grid run at dp = 1 mm and its start check (tag paper-start), whose
+    zeta_h is ``shift`` above the grid run's (every se 0.0005)."""
+    st = np.array([0.76, 1.5, 9.7])
+    ids = ["dp1mm_ch1.8_skillen", "dp1mm_ch1.8_skillen_paper-start"]
+    ds = xr.Dataset({"case_tag": ("case", ["", "paper-start"]), "case_steady": ("case", [1, 1]),
+                     "case_zeta_u": (("case", "station"), np.full((2, 3), 0.01)),
+                     "case_zeta_u_se": (("case", "station"), np.full((2, 3), 0.0005))},
+                    coords={"case": ids, "station": st})
+    for k, v in (("zeta_f", 0.01), ("zeta_h", 0.002), ("zeta_fs", 0.02)):
+        ds[f"case_{k}"] = ("case", [v, v + (shift if k == "zeta_h" else 0.0)])
+        ds[f"case_{k}_se"] = ("case", [0.0005, 0.0005])
+    return ds
+
+
+def test_the_start_check_sets_both_starts_side_by_side_and_says_whether_they_agree():
+    """zeta_h 0.1 % apart with se 0.05 % each (2 se of the difference 0.14 %): agree; 0.2 %
+    apart: zeta_h differs by more than 2 se, the rest agree. Without a start check, no section."""
+    from study import startcheck
+    from study.report import start_check_section
+    tab = startcheck.table(start_check_campaign(0.001))
+    assert list(tab["check"].values) == ["dp1mm_ch1.8_skillen_paper-start"]
+    assert bool(tab["agree"].all()) and "every metric agrees within 2 se" in start_check_section(
+        start_check_campaign(0.001))
+    tab = startcheck.table(start_check_campaign(0.002))
+    moved = [str(m) for m, a in zip(tab["metric"].values, tab["agree"].values[0]) if not a]
+    assert moved == ["zeta_h"]
+    text = start_check_section(start_check_campaign(0.002))
+    assert "1 of 6 metrics differ by more than 2 se (zeta_h)" in text and "0.2 %" in text
+    assert start_check_section(start_check_campaign(0.0).isel(case=[0])) == ""

@@ -272,7 +272,7 @@ def series_run(depth_noise=0.0, u_noise=0.0, depth_ramp=0.0, seed=0, n=51, windo
     depth = hn * (1.02 + depth_ramp * (t - t[0]) / window + depth_noise * rng.standard_normal(n))
     scale = 1.1 + u_noise * rng.standard_normal(n)
     run = xr.Dataset(
-        {"uniform_depth": ("time", depth),
+        {"uniform_depth": ("time", depth), "toe_position": ("time", np.full(n, 0.4)),
          "surface_elevation": (("time", "x_star"), np.tile(ref["surface"].values * hn, (n, 1))),
          "velocity_star": (("time", "station", "z_star"), scale[:, None, None] * ref["velocity"].values[None]),
          "front_velocity": ((), 0.0)},
@@ -316,6 +316,33 @@ def test_window_errors_recover_white_noise():
     # a noiseless record has no sampling error
     m = case_metrics(*series_run())
     assert float(m.zeta_h_se) < 1e-12 and float(m.zeta_fs_se) < 1e-12 and np.all(m.zeta_u_se.values < 1e-12)
+
+
+def test_metrics_over_the_hold_out_window_and_where_they_move():
+    """A record whose averaging window [2, 3] s holds the depth at 1.02 h_n and whose hold-out
+    (3, 4] s at 1.03 h_n (noise 0.1 % h_n): zeta_h over the hold-out is 0.03 within 2 se, and the
+    campaign flags zeta_h as moved by more than 2 se, nothing else; on a record whose hold-out
+    holds the depth, nothing moves."""
+    from study.campaign import holdout_moves
+
+    def record(step):
+        run, ref = series_run(depth_noise=0.001, n=101, window=2.0, seed=4)
+        t = run["time"].values
+        run["uniform_depth"] = run["uniform_depth"] + step * 0.01876 * (t > 3.0 + 1e-9)
+        run.attrs.update(window_start_s=2.0, window_end_s=3.0, holdout_start_s=3.02, holdout_end_s=4.0)
+        a = run.isel(time=np.flatnonzero(t <= 3.0 + 1e-9)).mean("time")
+        for k in ("uniform_depth", "surface_elevation", "velocity_star"):
+            run[f"mean_{k}"] = a[k]
+        return case_metrics(run, ref)
+
+    m = record(0.01)
+    assert float(m.zeta_h) == pytest.approx(0.02, abs=2 * float(m.zeta_h_se))
+    assert float(m.zeta_h_holdout) == pytest.approx(0.03, abs=2 * float(m.zeta_h_holdout_se))
+    assert float(m.zeta_h_holdout_se) < 0.002
+    for one, moved in ((m, ["zeta_h"]), (record(0.0), [])):
+        ds = xr.Dataset({f"case_{k}": (("case",) + one[k].dims, one[k].values[None])
+                         for k in one.data_vars if k.startswith("zeta")}, coords={"station": one.station.values})
+        assert [k for k, _, _ in holdout_moves(ds, 0)] == moved
 
 
 def test_window_errors_carry_the_depth_drift():

@@ -16,6 +16,7 @@ SCALARS = ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se", "zeta_h", "ze
            "zeta_fs_holdout", "zeta_fs_holdout_se")
 STATION_METRICS = ("zeta_u", "zeta_u_se", "zeta_u_measured", "zeta_u_holdout", "zeta_u_holdout_se")
 HOLDOUT_Z = 2.0  # a metric differs from its hold-out where |difference| > HOLDOUT_Z se of the difference
+ROUND_OFF = 1e-12  # a difference no larger is the rounding of two means of equal samples
 
 
 def holdout_shift(value, se, holdout, holdout_se):
@@ -23,7 +24,7 @@ def holdout_shift(value, se, holdout, holdout_se):
     diff = np.asarray(holdout, dtype=float) - np.asarray(value, dtype=float)
     se_diff = np.hypot(np.asarray(se, dtype=float), np.asarray(holdout_se, dtype=float))
     with np.errstate(invalid="ignore"):
-        differs = np.isfinite(diff) & np.isfinite(se_diff) & (np.abs(diff) > HOLDOUT_Z * se_diff)
+        differs = np.isfinite(diff) & np.isfinite(se_diff) & (np.abs(diff) > np.maximum(HOLDOUT_Z * se_diff, ROUND_OFF))
     return diff, se_diff, differs
 
 
