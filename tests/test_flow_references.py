@@ -1,11 +1,12 @@
-"""Reference solutions of the slump (study.flows), checked against quadrature, finite
-differences and a numerical solution of the lubrication equation."""
+"""Reference solutions of the slump and the start-up film (study.flows), checked against
+quadrature, finite differences and a numerical solution of the lubrication equation."""
 import math
 
 import numpy as np
 import pytest
 
-from study.flows import slump
+from solver import exact
+from study.flows import film, slump
 
 RHO, G = 1000.0, 9.81
 
@@ -206,3 +207,48 @@ def test_spreads_five_heights():
     assert slump.spreads_five_heights(0.1, 0.1, 1.0, RHO, G)
     assert slump.runout_ratio(0.1, 0.1, 100.0, RHO, G) == pytest.approx(2.226, abs=0.001)
     assert not slump.spreads_five_heights(0.1, 0.1, 100.0, RHO, G)
+
+
+# ---- film: start-up from rest -------------------------------------------------------------
+H, NU, THETA = 2e-3, 1e-4, math.radians(10.0)
+
+
+def test_film_starts_at_rest():
+    z = np.linspace(0.0, H, 41)
+    u_max = film.u_max(H, NU, G, THETA)
+    assert np.max(np.abs(film.velocity(z, 0.0, H, NU, G, THETA, terms=2000))) < 1e-6 * u_max
+    # with few terms the truncation shows: the check can fail
+    assert np.max(np.abs(film.velocity(z, 0.0, H, NU, G, THETA, terms=10))) > 1e-4 * u_max
+    assert np.isnan(film.velocity(1.1 * H, 0.0, H, NU, G, THETA))
+
+
+def test_film_tends_to_the_steady_parabola():
+    z = np.linspace(0.0, H, 41)
+    steady = exact.film(z, H, G * math.sin(THETA), NU)
+    late = film.velocity(z, 50 * H * H / NU, H, NU, G, THETA)
+    assert np.max(np.abs(late - steady)) < 1e-12 * film.u_max(H, NU, G, THETA)
+    assert steady[-1] == pytest.approx(film.u_max(H, NU, G, THETA), rel=1e-14)
+
+
+def test_film_solves_the_diffusion_equation():
+    """u_t = nu u_zz + g sin(theta), u(0) = 0, u_z(h) = 0, central differences, at nu t / h^2 = 0.05."""
+    t = 0.05 * H * H / NU
+    z = np.linspace(0.05, 0.95, 37) * H
+    dz, dt = 1e-3 * H, 1e-4 * t
+    def u(zz, tt):
+        return film.velocity(zz, tt, H, NU, G, THETA)
+    u_t = (u(z, t + dt) - u(z, t - dt)) / (2 * dt)
+    u_zz = (u(z + dz, t) - 2 * u(z, t) + u(z - dz, t)) / (dz * dz)
+    F = G * math.sin(THETA)
+    assert np.max(np.abs(u_t - NU * u_zz - F)) < 1e-5 * F
+    assert u(0.0, t) == pytest.approx(0.0, abs=1e-15)
+    # one-sided second-order slope at the surface, against the wall shear scale F h / nu
+    slope = (3 * u(H, t) - 4 * u(H - dz, t) + u(H - 2 * dz, t)) / (2 * dz)
+    assert abs(slope) < 1e-5 * F * H / NU
+
+
+def test_film_settling_time():
+    u_max = film.u_max(H, NU, G, THETA)
+    for f in (0.5, 0.1, 0.01):
+        t = film.settling_time(H, NU, f)
+        assert 1 - film.velocity(H, t, H, NU, G, THETA) / u_max == pytest.approx(f, rel=1e-3)
