@@ -1,12 +1,14 @@
 """Reference solutions of the slump and the start-up film (study.flows), checked against
-quadrature, finite differences and a numerical solution of the lubrication equation."""
+quadrature, finite differences and a numerical solution of the lubrication equation; the CSV
+reader of a user's reference and the errors against it."""
 import math
+import re
 
 import numpy as np
 import pytest
 
 from solver import exact
-from study.flows import film, slump
+from study.flows import film, slump, user
 
 RHO, G = 1000.0, 9.81
 
@@ -252,3 +254,124 @@ def test_film_settling_time():
     for f in (0.5, 0.1, 0.01):
         t = film.settling_time(H, NU, f)
         assert 1 - film.velocity(H, t, H, NU, G, THETA) / u_max == pytest.approx(f, rel=1e-3)
+
+
+# ---- user CSV references -------------------------------------------------------------------
+def write(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_reads_good_files(tmp_path):
+    front = user.read_front(write(tmp_path, "front.csv",
+                                  "# slump, run 3\n\nt, x_front, note  # seconds, metres\n"
+                                  "0.5, 0.10, a\n1.0, 0.12, b  # late\n2.0, 0.14, c\n"))
+    assert front.dims == ("t",) and front.name == "x_front"
+    assert np.array_equal(front["t"].values, [0.5, 1.0, 2.0]) and np.allclose(front.values, [0.10, 0.12, 0.14])
+    assert front.attrs["units"] == "m" and front["t"].attrs["units"] == "s"
+    depth = user.read_depth_profiles(write(tmp_path, "depth.csv",
+                                           "t,x,h\n1,0,0.05\n1,0.1,0.04\n1,0.2,0.0\n2,0,0.04\n2,0.15,0.03\n"))
+    assert depth.dims == ("t", "x") and depth.name == "h"
+    assert np.array_equal(depth["x"].values, [0.0, 0.1, 0.15, 0.2])
+    assert np.allclose(depth.sel(t=2.0).dropna("x").values, [0.04, 0.03])
+    assert np.isnan(depth.sel(t=1.0, x=0.15))
+    vel = user.read_velocity_profiles(write(tmp_path, "u.csv", "z,u,x\n0,0,0.3\n0.01,0.2,0.3\n0,0,0.5\n0.02,0.1,0.5\n"))
+    assert vel.dims == ("x", "z") and np.allclose(vel.sel(x=0.5).dropna("z").values, [0.0, 0.1])
+
+
+def test_reads_windows_files(tmp_path):
+    """A byte-order mark and CRLF line ends, as a spreadsheet saves them; lines still counted right."""
+    path = tmp_path / "excel.csv"
+    path.write_bytes("\ufefft,x_front\r\n0,1\r\n1,2\r\n".encode("utf-8"))
+    assert np.allclose(user.read_front(path).values, [1.0, 2.0])
+    path.write_bytes("\ufeff# c\r\nt,x_front\r\n0,1\r\n1,x\r\n".encode("utf-8"))
+    with pytest.raises(ValueError, match="line 4: 'x' in column x_front is not a number"):
+        user.read_front(path)
+
+
+BAD_FRONTS = [
+    ("# c\nt,x_front\n0,1\n1,abc\n", "line 4: 'abc' in column x_front is not a number"),
+    ("t,x_front\n0,1\n1,2,3\n", "line 3: 3 values, expected 2"),
+    ("t,x_front\n0,1\n1\n", "line 3: 1 value, expected 2"),
+    ("# a\n# b\nt,x\n0,1\n1,2\n", "line 3: missing column(s) x_front in the header"),
+    ("0,1\n1,2\n", "line 1: no header row"),
+    ("# only a comment\n", "line 1: no header row"),
+    ("t,t,x_front\n0,0,1\n1,1,2\n", "line 1: column(s) t named twice"),
+    ("t,x_front\n0,1\n2,2\n# out of order\n\n1,3\n", "line 6: t = 1 is not after t = 2 (line 3); times must ascend"),
+    ("t,x_front\n0,1\n0,2\n", "line 3: t = 0 is not after t = 0 (line 2)"),
+    ("t,x_front\n# one row\n0,1\n", "line 3: the file ends after 1 data row(s); at least 2 needed"),
+    ("t,x_front\n0,1\n1,nan\n", "line 3: 'nan' in column x_front is not a finite number"),
+    ("t,x_front\n0,1\n1,inf\n", "line 3: 'inf' in column x_front is not a finite number"),
+    ("t,x_front\n0,1\n1,\n", "line 3: '' in column x_front is not a number"),
+    ("t,x_front\n0,0\n1,1\n", "line 2: x_front = 0 is not positive"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD_FRONTS)
+def test_refuses_bad_front_files(tmp_path, text, message):
+    path = write(tmp_path, "ref.csv", text)
+    with pytest.raises(ValueError, match=re.escape(f"{path} {message}")):
+        user.read_front(path)
+
+
+BAD_PROFILES = [
+    (user.read_depth_profiles, "t,x,h\n1,0,1\n1,0.1,0.5\n2,0,1\n3,0,1\n3,1,0\n",
+     "line 4: the profile at t = 2 has 1 point; at least 2 needed"),
+    (user.read_depth_profiles, "t,x,h\n1,0,1\n1,0.2,0.5\n1,0.1,0.4\n",
+     "line 4: x = 0.1 is not after x = 0.2 (line 3) within the profile at t = 1"),
+    (user.read_depth_profiles, "t,x,h\n2,0,1\n2,1,0\n1,0,1\n1,1,0\n",
+     "line 4: t = 1 comes after the profile at t = 2 (line 3); profiles must come in ascending t"),
+    (user.read_depth_profiles, "t,x,h\n1,0,1\n1,1,-0.1\n", "line 3: h = -0.1 is negative"),
+    (user.read_depth_profiles, "t,x\n1,0\n1,1\n", "line 1: missing column(s) h"),
+    (user.read_velocity_profiles, "x,z,u\n0.3,0,0\n0.3,0,0.1\n", "line 3: z = 0 is not after z = 0 (line 2)"),
+    (user.read_velocity_profiles, "x,z,u\n0.3,0,0\n0.3,1,1\n0.3,2,2\n0.1,0,0\n0.1,1,1\n",
+     "line 5: x = 0.1 comes after the profile at x = 0.3 (line 4)"),
+]
+
+
+@pytest.mark.parametrize("reader, text, message", BAD_PROFILES)
+def test_refuses_bad_profile_files(tmp_path, reader, text, message):
+    path = write(tmp_path, "ref.csv", text)
+    with pytest.raises(ValueError, match=re.escape(f"{path} {message}")):
+        reader(path)
+
+
+def test_front_error():
+    t = np.linspace(1.0, 10.0, 19)
+    x = slump.front_position(t, 1e-3, 1e-3, G)
+    assert user.front_error(t, x, t, x) == 0.0
+    assert user.front_error(t, x, t, 1.05 * x) == pytest.approx(0.05, rel=1e-12)
+    # the interval selects the reference times; only they count
+    bad = np.where(t > 5.0, 2.0 * x, x)
+    assert user.front_error(t, x, t, bad, (1.0, 5.0)) == 0.0
+    assert user.front_error(t, x, t, bad, (5.5, 10.0)) == pytest.approx(1.0)
+    # never extrapolated: a run that stops at t = 5 is measured up to t = 5
+    assert user.front_error(t, x, t[t <= 5], 1.02 * x[t <= 5]) == pytest.approx(0.02)
+    # never bridged: reference times inside a stretch where the run is undefined do not count
+    gappy = np.where((t > 4) & (t < 7), np.nan, 1.03 * x)
+    assert user.front_error(t, x, t, gappy) == pytest.approx(0.03)
+    assert math.isnan(user.front_error(t, x, t + 20.0, x))
+
+
+def test_front_error_from_a_file_against_the_similarity_front(tmp_path):
+    t = np.linspace(2.0, 20.0, 10)
+    x = slump.front_position(t, 1e-3, 1e-3, G)
+    rows = "\n".join(f"{a:.17g},{b:.17g}" for a, b in zip(t, 1.05 * x))
+    ref = user.read_front(write(tmp_path, "ref.csv", "t,x_front\n" + rows + "\n"))
+    fine = np.linspace(0.0, 30.0, 3001)
+    err = user.front_error(ref["t"], ref, fine, slump.front_position(fine, 1e-3, 1e-3, G))
+    assert err == pytest.approx(1 - 1 / 1.05, rel=1e-4)  # linear interpolation of the run: 1e-6 off
+
+
+def test_profile_error():
+    z = np.linspace(0.0, H, 21)
+    u = film.velocity(z, 1.0, H, NU, G, THETA)
+    assert user.profile_error(z, u, z, u) == 0.0
+    scale = np.max(np.abs(u))
+    assert user.profile_error(z, u, z, u + 0.02 * scale) == pytest.approx(0.02, rel=1e-12)
+    assert user.profile_error(z, u, z, u + 0.02, scale=0.5) == pytest.approx(0.04, rel=1e-12)
+    # a run on another grid is interpolated onto the reference's heights, never extrapolated
+    zr = np.linspace(0.0, 0.5 * H, 101)
+    ur = film.velocity(zr, 1.0, H, NU, G, THETA)
+    assert user.profile_error(z, u, zr, ur) < 1e-4
