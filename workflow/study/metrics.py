@@ -62,21 +62,29 @@ def zeta_h(depth: float, h_ref: float) -> float:
     return abs(depth - h_ref) / h_ref
 
 
+def on_abscissas(x_ref, x_run, y_run) -> np.ndarray:
+    """A run's curve y_run(x_run) interpolated linearly onto the reference abscissas x_ref; NaN
+    outside the run's defined samples (never extrapolated) and over a stretch where the run is
+    undefined (never bridged)."""
+    x_ref = np.asarray(x_ref, dtype=float)
+    order = np.argsort(np.asarray(x_run, dtype=float), kind="stable")
+    xs = np.asarray(x_run, dtype=float)[order]
+    ys = np.asarray(y_run, dtype=float)[order]
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    out = np.full(x_ref.size, np.nan)
+    if ok.sum() < 2:
+        return out
+    inside = (x_ref >= xs[ok].min()) & (x_ref <= xs[ok].max())
+    out[inside] = np.interp(x_ref[inside], xs[ok], ys[ok])
+    fin = np.isfinite(xs)
+    out[np.interp(x_ref, xs[fin], (~ok[fin]).astype(float)) > 0] = np.nan
+    return out
+
+
 def rms_difference(reference: xr.DataArray, numerical: xr.DataArray, dim: str) -> float:
     """sqrt(mean (ref - num)^2) over the reference's abscissas along ``dim`` where both are
-    defined; the numerical curve is interpolated linearly onto them."""
-    xs = numerical[dim].values
-    ys = numerical.values
-    ok = np.isfinite(ys)
-    xr_ = reference[dim].values
-    num = np.full(xr_.size, np.nan)
-    if ok.sum() >= 2:
-        inside = (xr_ >= xs[ok].min()) & (xr_ <= xs[ok].max())
-        num[inside] = np.interp(xr_[inside], xs[ok], ys[ok])
-        # no extrapolation, and no bridging over undefined stretches of the numerical curve
-        gap = np.interp(xr_, xs, (~ok).astype(float)) > 0
-        num[gap] = np.nan
-    diff = reference.values - num
+    defined; the numerical curve is interpolated onto them (``on_abscissas``)."""
+    diff = reference.values - on_abscissas(reference[dim].values, numerical[dim].values, numerical.values)
     ok = np.isfinite(diff)
     if not ok.any():
         return float("nan")

@@ -173,23 +173,10 @@ def _grid(path: Path, v: np.ndarray, columns) -> xr.DataArray:
 
 
 def on_reference(x_ref, x_run, y_run) -> np.ndarray:
-    """A run's curve y_run(x_run) interpolated linearly onto the reference's abscissas x_ref;
-    NaN outside the run's defined samples (never extrapolated) and over a stretch where the
-    run is undefined (never bridged): the rule of study.metrics.rms_difference."""
-    x_ref = np.asarray(x_ref, dtype=float)
-    order = np.argsort(np.asarray(x_run, dtype=float), kind="stable")
-    xs = np.asarray(x_run, dtype=float)[order]
-    ys = np.asarray(y_run, dtype=float)[order]
-    ok = np.isfinite(xs) & np.isfinite(ys)
-    out = np.full(x_ref.size, np.nan)
-    if ok.sum() < 2:
-        return out
-    inside = (x_ref >= xs[ok].min()) & (x_ref <= xs[ok].max())
-    out[inside] = np.interp(x_ref[inside], xs[ok], ys[ok])
-    fin = np.isfinite(xs)
-    gap = np.interp(x_ref, xs[fin], (~ok[fin]).astype(float)) > 0
-    out[gap] = np.nan
-    return out
+    """A run's curve interpolated onto the reference's abscissas, as every metric does
+    (study.metrics.on_abscissas: never extrapolated, never bridged over a gap)."""
+    from ..metrics import on_abscissas
+    return on_abscissas(x_ref, x_run, y_run)
 
 
 def _rms(values) -> float:
