@@ -8,14 +8,16 @@ and a case then costs
 
     wall = start-up + T_sim / dt * N / rate
 
-with T_sim from --t-sim (T, METHOD=T or METHOD@DP_MM=T: the steady time plus the averaging
-window, 4 s by default) and, as the upper bound, the case's steady.max_time. Realisations of an
+with T_sim from --t-sim (T, METHOD=T or METHOD@DP_MM=T: the simulated time at which a run ends
+steady, the end of its hold-out window; by default 12.5 s for Skillen and 16.5 s for Lind, what
+the default campaign's dp = 1 mm runs from the lubrication start took) and, as the upper bound,
+the case's steady.max_time. Realisations of an
 ensemble cost what their case does. --coarse-only measures the coarsest dp at every Ch and the
 finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at another Ch takes
 its paper-Ch run's dt, rate and N times their Ch ratio at the coarsest dp.
 
     python -m benchmarks.paper_grid [--config config/paper.yaml] [--threads 2] [--time 0.05] [--fine-time 0.02]
-        [--t-sim 4.0 lind=4.2 skillen@0.25=5] [--shifting skillen lind] [--coarsest N] [--paper-ch-only]
+        [--t-sim 12.5 lind=16.5 skillen@0.25=10] [--shifting skillen lind] [--coarsest N] [--paper-ch-only]
         [--coarse-only] [--set KEY=VALUE ...] [--out DIR] [--reuse]
 
 --shifting, --coarsest and --paper-ch-only project only part of the grid (--quick: Skillen's
@@ -76,7 +78,7 @@ def measure(data: dict, sets, sim_time: float) -> dict:
 
 def t_sim_of(specs, method: str, dp: float) -> float:
     """T_sim of a case from --t-sim entries: T, METHOD=T or METHOD@DP_MM=T, the most specific wins."""
-    best, rank = 4.0, -1
+    best, rank = 12.5, -1
     for s in specs:
         key, _, value = s.rpartition("=")
         r = 0 if not key else 2 if key == f"{method}@{dp * 1e3:g}" else 1 if key == method else -1
@@ -90,7 +92,7 @@ def main(argv=None) -> int:
     ap.add_argument("--config", type=Path, default=common.ROOT / "config" / "paper.yaml")
     ap.add_argument("--time", type=float, default=0.05, help="simulated seconds of each run")
     ap.add_argument("--fine-time", type=float, default=0.02, help="simulated seconds below dp = 0.4 mm")
-    ap.add_argument("--t-sim", nargs="+", default=["4.0"], metavar="[METHOD[@DP_MM]=]T")
+    ap.add_argument("--t-sim", nargs="+", default=["12.5", "lind=16.5"], metavar="[METHOD[@DP_MM]=]T")
     ap.add_argument("--shifting", nargs="+", default=None, help="only these methods' cases (default: all)")
     ap.add_argument("--coarsest", type=int, default=None, metavar="N", help="only the N coarsest dp (default: all)")
     ap.add_argument("--paper-ch-only", action="store_true", help="only the paper Ch")
