@@ -1,4 +1,5 @@
-"""Projected wall time of a campaign (default config/paper.yaml) on this host, from short runs.
+"""Projected wall time of a campaign's grid runs (default config/paper.yaml; its start checks are not
+included) on this host, from short runs.
 
 Each grid case of the config runs --time s of simulated time (--fine-time below dp = 0.4 mm) on
 --threads threads, after a compile run, from the solver case file the campaign writes for it

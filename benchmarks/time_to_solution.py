@@ -1,4 +1,4 @@
-"""Time to a steady answer: a conveyor case run to steady state plus its averaging window, per
+"""Time to a steady answer: a conveyor case run until its averaging window and the hold-out after it pass, per
 shifting method and variant: wall time, steps, particle-steps/s, steady time, simulated time and
 the metrics against lubrication theory (study.metrics.case_metrics).
 

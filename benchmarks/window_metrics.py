@@ -12,7 +12,7 @@ depth's deviation from its mean over all windows [% h_n], the enclosed-area drif
 deviation from its mean [dp], and where the run has them the volume budget by zone
 (enclosed / mass-implied area - 1: wall, body, front) and the interior disorder
 h |sum V gradW|. Then the settling targets over those windows (depth within 0.5 % h_n, area
-drift within 1 %, toe within 1 dp) and the toe's hold-out: the share of 2 s windows, one
+drift within 1 %, toe within 1 dp) and the toe's sliding-window check: the share of 2 s windows, one
 every 0.1 s, whose mean toe lies beyond 1 dp of its mean.
 
     python -m benchmarks.window_metrics RUN.nc [RUN.nc ...] [--length 1 --stride 0.5 --from 1]

@@ -85,8 +85,9 @@ def strip_mean_velocity(x, z, u, volume, x_station, h):
 
 
 class FrontMonitor:
-    """Samples the probes every ``case.probes.interval``; detects steady state, then ends
-    the run after the averaging window. Fires the area-drift guard."""
+    """Samples the probes every ``case.probes.interval``; ends the run at the end of the first
+    steady window pair (the hold-out after the averaging window, solver/steady.py). Fires the
+    area-drift guard."""
 
     def __init__(self, case: ConveyorCase):
         self.case = case
@@ -241,14 +242,14 @@ class FrontMonitor:
                                  {"units": "m", "long_name": "x0 + fluid area downstream of x0 / h_n, lab frame "
                                   f"(x0 = {self.x_anchor:.6g} m, {FRONT_ANCHOR:g} h_n upstream of the first toe or "
                                   "half-way to the wall if nearer); "
-                                  "the steady detection's front signal"}),
+                                  "zeta_f_body's front"}),
             "station_mean_velocity": (("time", "station"), self.station_means(),
                                       {"units": "1", "long_name": "depth-mean u* at the station: volume-weighted mean "
                                        "of the fluid particles within +-2h of it"}),
             "station_front": (("time", "station"), self.station_fronts(),
                               {"units": "m", "long_name": "x_s + fluid area downstream of x_s / h_n, lab frame, "
                                "x_s fixed at each station's x* upslope of the first toe (half-way to the wall if "
-                               "nearer); the steady detection's station signals"}),
+                               "nearer); a diagnostic"}),
             "uniform_depth": (("time",), np.asarray(self.series["uniform_depth"]),
                               {"units": "m", "long_name": "mean free-surface elevation over the uniform zone"}),
             "enclosed_area": (("time",), np.asarray(self.series["enclosed_area"]),
@@ -306,7 +307,7 @@ class FrontMonitor:
             j = self.detector.found
         elif t.size >= 8 and t[-1] - t[0] >= 2.0 * w - 1e-9:
             j = self.final_judgement()
-        steady_found = j is not None and j.steady
+        steady_found = j is not None and j.steady and j.averaging[0] >= self.detector.crit.min_time - 1e-9
         nan = math.nan
         (a0, a1), (b0, b1) = (j.averaging, j.holdout) if j is not None else \
             (((t[-1] - w, t[-1]) if t.size else (nan, nan)), (nan, nan))
@@ -502,7 +503,7 @@ def record_of(ds: xr.Dataset, case: ConveyorCase) -> steady.Record:
 def recorded_case(ds: xr.Dataset, sets: dict | None = None) -> ConveyorCase:
     """The case a run recorded (``case_yaml``), with ``sets`` ({dotted key: value}) applied; a
     record's steady keys that the detection no longer reads are left out, so that an older run
-    replays with today's detection."""
+    replays with today's rule (and its own recorded steady.average as W, and min_time)."""
     import yaml
     from dataclasses import fields
     from .conveyor import Steady, case_from_dict

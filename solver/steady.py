@@ -5,10 +5,10 @@ Quantities, each a set of components sampled every probe interval:
 
   toe      the toe's distance from the upstream wall (zeta_f)         1 component
   depth    the uniform depth h_u / h_n (zeta_h)                      1 component
-  surface  the free surface z / h_n at each x* in [0, x_max] (zeta_fs)
+  surface  the free surface z / h_n at each x* in [0, uniform_zone[1]] (zeta_fs)
   station  u* at each z* of one station (zeta_u), one quantity a station
 
-A window pair is an averaging window A = [t - 2W, t - W] and a hold-out window B = [t - W, t].
+A window pair is an averaging window A = [t - 2W, t - W] and a hold-out window B = (t - W, t].
 Over each window every component y_i gets a least-squares line: mean m_i with standard error
 s_i, slope b_i with standard error sb_i (residual variance, widened for the residuals' lag-1
 correlation; ``_line_fits``). Each component's two drifts, over its allowance:
@@ -17,8 +17,9 @@ correlation; ``_line_fits``). Each component's two drifts, over its allowance:
   fitted change    e_i = b_A,i W / max(Z sb_A,i W, f |m_A,i|)
 
 Z = 2, f = steady.fraction. A quantity's ratios are R_D = rms_i d_i and R_F = rms_i e_i over
-the components measured in both windows; the pair is steady when every R is at most 1. The toe's
-fitted change is zeta_f's front velocity times W: with a fixed volume of fluid, a front that
+the components measured in both windows (none: the quantity fails); the pair is steady when
+every R is at most 1. The toe's fitted change is its mean velocity over A times W: with a fixed
+volume of fluid, a front that
 creeps by a fraction of the layer's length thins the layer by that fraction, which the same
 fraction of the depth bounds. The first probe time t >= min_time + 2W at which a pair is steady
 ends the run; its A is the averaging window and its B the hold-out.
@@ -208,7 +209,8 @@ def _drift_ratios(ta, ya, tb, yb, window: float, fraction: float) -> tuple[float
 
 
 def judge(rec: Record, t_end: float, crit: SteadyCriteria, u_b: float) -> Judgement:
-    """The window pair ending at ``t_end``: A = [t_end - 2W, t_end - W], B = [t_end - W, t_end]."""
+    """The window pair ending at ``t_end``: A = [t_end - 2W, t_end - W], B = (t_end - W, t_end];
+    not judged (no drifts: not steady) with fewer than 8 samples in A or 4 in B."""
     w, f = crit.window, crit.fraction
     out = Judgement(t_end, w)
     t = rec.t
@@ -226,8 +228,8 @@ def judge(rec: Record, t_end: float, crit: SteadyCriteria, u_b: float) -> Judgem
 
 
 class SteadyDetector:
-    """Judges the window pair ending at each probe time from ``crit.min_time + 2W`` on; the
-    first steady pair is the run's (``found``)."""
+    """Judges the window pair ending at each probe time from max(crit.min_time, first sample)
+    + 2W on; the first steady pair is the run's (``found``)."""
 
     def __init__(self, crit: SteadyCriteria, u_b: float):
         self.crit, self.u_b = crit, u_b

@@ -66,7 +66,7 @@ def test_line_fit_errors_match_the_scatter_of_means_and_slopes():
 
 def test_depth_drifting_by_0_05_percent_of_h_n_a_second_is_never_steady():
     """The uniform depth drifts by 0.05 % h_n a second for 12 s, everything else still: never
-    steady, for 10 of 10 noise realisations (a tolerance of 0.5 % h_n a window calls it steady)."""
+    steady, for 10 of 10 noise realisations."""
     for seed in range(10):
         assert first_steady(series(depth_drift=5e-4, seed=seed)) is None, seed
 

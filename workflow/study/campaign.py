@@ -48,7 +48,7 @@ RUN_NUMBERS = {
     "steps": ("steps", "1", "time steps"),
     "n_particles": ("n_particles", "1", "particles (fluid and wall)"),
     "simulated_time": ("simulated_time_s", "s", "simulated time"),
-    "steady_state_time": ("steady_state_time_s", "s", "time steady state was detected"),
+    "steady_state_time": ("steady_state_time_s", "s", "start of the steady averaging window"),
     "threads": ("threads", "1", "threads"),
     "cfl_acoustic": ("cfl_acoustic", "1", "C_CFL of the acoustic limit the run used (cfl_rule)"),
 }

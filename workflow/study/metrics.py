@@ -44,8 +44,7 @@ def last_second_velocity(t, position, u_b: float) -> tuple[float, float]:
 
 def zeta_f_error(t, toe, u_b: float) -> float:
     """Standard error of zeta_f from the toe's own scatter (``last_second_velocity``). A wander
-    of the toe slower than the second shows as slope, not scatter: at dp <= 1 mm the one-second
-    velocities of a settled front scatter by up to 1.6 times this se (docs/conveyor.md)."""
+    of the toe slower than the second shows as slope, not scatter."""
     return last_second_velocity(t, toe, u_b)[1]
 
 
@@ -120,16 +119,17 @@ def profile_metrics(depth: float, surface: xr.DataArray, velocity: xr.DataArray,
     return out, zu
 
 
-def _samples(run: xr.Dataset, start_attr: str, end_attr: str) -> np.ndarray | None:
-    """Indices of the time samples in [run.attrs[start_attr], run.attrs[end_attr]] (None where
-    the run lacks the record or the window)."""
+def _samples(run: xr.Dataset, start_attr: str, end_attr: str, open_start: bool = False) -> np.ndarray | None:
+    """Indices of the time samples in [run.attrs[start_attr], run.attrs[end_attr]] (the start
+    left out with ``open_start``; None where the run lacks the record or the window)."""
     if "uniform_depth" not in run or run.sizes.get("time", 0) == 0:
         return None
     a, b = float(run.attrs.get(start_attr, np.nan)), float(run.attrs.get(end_attr, np.nan))
     if not (np.isfinite(a) and np.isfinite(b)):
         return None
     t = run["time"].values
-    idx = np.flatnonzero((t >= a - 1e-9) & (t <= b + 1e-9))
+    after = (t > a + 1e-9) if open_start else (t >= a - 1e-9)
+    idx = np.flatnonzero(after & (t <= b + 1e-9))
     return idx if idx.size else None
 
 
@@ -147,9 +147,9 @@ def window_samples(run: xr.Dataset) -> np.ndarray | None:
 
 
 def holdout_samples(run: xr.Dataset) -> np.ndarray | None:
-    """Indices of the hold-out window's samples (attrs holdout_start_s to holdout_end_s), None
-    where the run has none."""
-    return _samples(run, "holdout_start_s", "holdout_end_s")
+    """Indices of the hold-out window's samples, (holdout_start_s, holdout_end_s] (its first
+    instant is the averaging window's last sample), None where the run has none."""
+    return _samples(run, "holdout_start_s", "holdout_end_s", open_start=True)
 
 
 def jackknife_se(leave_one_out: np.ndarray) -> np.ndarray:
@@ -204,7 +204,7 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     averaging window, and the same over its hold-out window (``*_holdout``) where it has one.
 
     Diverged runs give NaN metrics. A run that did not reach steady state gives its metrics
-    over its final window, flagged by ``steady = 0`` (the report and figures mark them).
+    over its final pair's averaging window, flagged by ``steady = 0`` (the report and figures mark them).
     """
     st = ref["station"].values
     out = {k: np.nan for k in ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se") + PROFILE_METRICS

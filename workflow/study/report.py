@@ -63,9 +63,9 @@ def _with_error(value, se) -> str:
 
 def case_table(ds: xr.Dataset) -> str:
     st = ds["station"].values
-    head = ["case", "status", "steady", "wall time [s]", "steps", "C_CFL used", "particles", "steady at [s]",
-            "zeta_f [%] (± 2 se)", "zeta_f of the front's body [%] (± 2 se)", "zeta_h [%] (h_n, ± 2 se)",
-            "zeta_h [%] (paper, ± 2 se)", "zeta_fs [%] (± 2 se)"] + [
+    head = ["case", "status", "steady", "wall time [s]", "steps", "C_CFL used", "particles",
+            "averaging window from [s]", "zeta_f [%] (± 2 se)", "zeta_f of the front's body [%] (± 2 se)",
+            "zeta_h [%] (h_n, ± 2 se)", "zeta_h [%] (paper, ± 2 se)", "zeta_fs [%] (± 2 se)"] + [
                 f"zeta_u x*={s:g} [%] (± 2 se)" for s in st]
     head.append("hold-out: metrics that moved by more than 2 se")
     rows = []
@@ -347,8 +347,8 @@ def ensemble_paragraph(ds: xr.Dataset) -> str:
     amp = float(ds.attrs.get("start_perturbation", np.nan))
     stagger = float(ds.attrs.get("window_stagger", 0.0))
     later = (f", and realisation k's steady.min_time is raised by k &times; {stagger:g} s, so that "
-             "its averaging window opens later and the windows sample a motion the runs share rather "
-             "than one phase of it") if stagger > 0 else ""
+             "its averaging window opens no earlier than that, and the windows may sample a motion the "
+             "runs share rather than one phase of it") if stagger > 0 else ""
     return (f"<p><b>Ensemble:</b> {ensemble_counts(ds)}. Realisation 0 is the case as configured, "
             f"the others move each fluid particle's start by up to {amp:g} dp (ids ending in _r1, "
             f"_r2, ...; all in the case table){later}. A grid point's metrics are the means over its "
@@ -381,16 +381,14 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "zeta_h, zeta_fs, zeta_u: a block jackknife over the window, zeta_h's with half the "
                "depth's drift through it). It is not the discretisation error, and the verdicts and "
                "the cheapest runs use it: a value is below a threshold only by more than 2 se, two "
-               "runs within 2 se tie. Nor does it hold the spread between realisations: rerun with "
-               "other rounding (another thread count), the default campaign's Lind runs and its "
-               "coarsest Skillen run at Ch = 1.3 moved zeta_fs and zeta_u by up to 6.8 times the two "
-               "runs' combined se, and no "
-               "verdict changed (docs/conveyor.md, \"Round-off realisations\"). The campaign key "
+               "runs within 2 se tie. Nor does it hold how far a metric wanders from one window to the "
+               "next: the case table's hold-out column shows where a run's metrics moved by more than "
+               "2 se into the window after. The campaign key "
                "ensemble runs each grid case in several realisations and puts their spread into the se. "
                "The case table's zeta_f of the front's body, beyond the paper, is the same error of the "
                "equivalent front (the fluid area downstream of a lab-fixed point over h_n) over the same "
                "second: where zeta_f reads more than it, the toe wandered or particles joined or left the "
-               "tip while the front itself held (docs/conveyor.md, \"The toe's wander\").</p>"
+               "tip while the front itself held.</p>"
                + ensemble_paragraph(ds))
     figs = []
     for path, title, caption in figures:
