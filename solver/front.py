@@ -190,9 +190,14 @@ class FrontMonitor:
     def why_not_steady(self) -> str:
         """Which quantities drift beyond their allowance over the final window pair."""
         t = np.asarray(self.t)
-        if t.size < 8 or t[-1] - t[0] < 2.0 * self.detector.crit.window:
+        crit = self.detector.crit
+        if t.size < 8 or t[-1] - t[0] < 2.0 * crit.window:
             return "the record is shorter than two averaging windows"
-        return self.final_judgement().describe()
+        j = self.final_judgement()
+        if j.steady and j.averaging[0] < crit.min_time - 1e-9:
+            return (f"{j.describe()}, but its averaging window starts before {crit.min_time:g} s (the end of "
+                    "the belt's ramp plus steady.min_time)")
+        return j.describe()
 
     def station_fronts(self) -> np.ndarray:
         """Equivalent front from each station's lab-fixed anchor over time, (time, station)."""
