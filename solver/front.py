@@ -305,7 +305,8 @@ class FrontMonitor:
         # the averaging window A and its hold-out B: with steady.stop, the first steady pair;
         # otherwise (fixed end time, or no steady pair by max_time) the pair ending at the last
         # sample, steady only if it passes; a record shorter than two windows averages its final
-        # window, not steady, without a hold-out. Nothing that is not steady passes for steady.
+        # window (all of it when shorter), not steady, without a hold-out. Nothing that is not
+        # steady passes for steady.
         w = self.detector.crit.window
         j = None
         if c.steady.stop and self.detector.found is not None:
@@ -315,7 +316,7 @@ class FrontMonitor:
         steady_found = j is not None and j.steady and j.averaging[0] >= self.detector.crit.min_time - 1e-9
         nan = math.nan
         (a0, a1), (b0, b1) = (j.averaging, j.holdout) if j is not None else \
-            (((t[-1] - w, t[-1]) if t.size else (nan, nan)), (nan, nan))
+            (((max(t[0], t[-1] - w), t[-1]) if t.size else (nan, nan)), (nan, nan))
         ds.attrs["steady_state_time_s"] = float(a0) if steady_found else nan
         ds.attrs["steady"] = int(steady_found)
         ds.attrs["averaging"] = "steady window" if steady_found else "final window, NOT steady"
@@ -324,7 +325,7 @@ class FrontMonitor:
         ds.attrs["steady_judgement"] = j.describe() if j is not None else "record shorter than two windows"
         for q, r in (j.ratios.items() if j is not None else ()):
             ds.attrs[f"drift_ratio_{q.replace(' ', '_')}"] = float(r)
-        if t.size and t[-1] - t[0] >= w - 1e-9:
+        if t.size >= 2:
             win = (t >= a0 - 1e-9) & (t <= a1 + 1e-9)
             tw = t[win]
             avg = ds.isel(time=win).mean("time")
