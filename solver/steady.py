@@ -33,7 +33,6 @@ import numba as nb
 import numpy as np
 
 Z = 2.0  # standard errors a drift may reach before it counts as real
-QUANTITIES = ("toe", "depth", "surface", "station")
 
 
 @dataclass
@@ -49,7 +48,7 @@ class Record:
     t: np.ndarray  # (n,) s
     toe: np.ndarray  # (n,) m
     depth: np.ndarray  # (n,) h_u / h_n
-    surface: np.ndarray  # (n, nx) z / h_n over x* in [0, x_max]
+    surface: np.ndarray  # (n, nx) z / h_n over x* in [0, uniform_zone[1]]
     stations: np.ndarray  # (n, ns, nz) u*
 
     def span(self, start: float, end: float = math.inf) -> Record:
