@@ -5,7 +5,7 @@ With --late T0 T1 it first compares the metrics over the averaging window that t
 detection (solver/steady.py, replayed on the run's probe series) picks with those over
 [T0, T1], each with its se, and says which agree within 2 se of their difference. Then, for
 each window [t0, t0 + length], t0 from --from (seconds, or ``steady``: the detected window's
-start) in steps of --stride, it prints the
+start, 2 s where none is found) in steps of --stride, it prints the
 study's metrics over the window (study.metrics.case_metrics against lubrication theory, the
 probe series averaged over the window as a run averages its steady window), the uniform
 depth's deviation from its mean over all windows [% h_n], the enclosed-area drift, the toe's
