@@ -52,11 +52,8 @@ def replay(run: xr.Dataset, sets=()) -> tuple[float, float]:
     """(start, end) of the averaging window the steady detection (solver/steady.py, the run's own
     steady keys with ``sets`` applied, KEY=VALUE) finds on the run's probe series; NaN, NaN where
     it finds none."""
-    import yaml
-
     from solver.front import recorded_case, replay as replay_detection
-    found = replay_detection(run, recorded_case(run, {k: yaml.safe_load(v) for k, v in
-                                                      (s.split("=", 1) for s in sets)}))
+    found = replay_detection(run, recorded_case(run, sets))
     return found.averaging if found is not None else (math.nan, math.nan)
 
 

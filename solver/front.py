@@ -96,8 +96,7 @@ class FrontMonitor:
         self.x_star = np.round(np.arange(0.0, p.x_star_max + 0.5 * p.x_star_step, p.x_star_step), 10)
         self.z_star = np.round(np.arange(0.0, p.z_star_max + 0.5 * p.z_star_step, p.z_star_step), 10)
         self.stations = np.asarray(p.stations, dtype=float)
-        self.x_detect = self.x_star <= p.uniform_zone[1] + 1e-9  # the surface the detector watches
-        self.detector = steady.SteadyDetector(case.criteria(), case.belt.speed)
+        self.detector = steady.SteadyDetector(case.criteria())
         self.state = "transient"
         self.t: list[float] = []
         self.series = {k: [] for k in SERIES}
@@ -119,17 +118,15 @@ class FrontMonitor:
     def record(self, start: float = -math.inf) -> steady.Record:
         """The detector's quantities from the probe samples at or after ``start``."""
         i = bisect.bisect_left(self.t, start - 1e-9)
-        hn, n = self.case.h_n, len(self.t) - i
-        return steady.Record(np.asarray(self.t[i:], dtype=float),
-                             np.asarray(self.series["toe"][i:], dtype=float),
-                             np.asarray(self.series["uniform_depth"][i:], dtype=float) / hn,
-                             np.asarray(self.surface[i:], dtype=float).reshape(n, -1)[:, self.x_detect] / hn,
-                             np.asarray(self.velocity[i:], dtype=float).reshape(n, self.stations.size, -1))
+        n = len(self.t) - i
+        return detector_record(self.case, self.x_star, self.t[i:], self.series["toe"][i:],
+                               self.series["uniform_depth"][i:],
+                               np.asarray(self.surface[i:], dtype=float).reshape(n, -1),
+                               np.asarray(self.velocity[i:], dtype=float).reshape(n, self.stations.size, -1))
 
     def final_judgement(self) -> steady.Judgement:
         """The window pair ending at the last sample."""
-        d = self.detector
-        return steady.judge(self.record(), float(self.t[-1]), d.crit, d.u_b)
+        return steady.judge(self.record(), float(self.t[-1]), self.detector.crit)
 
     # ---- one sample ---------------------------------------------------------------
     def sample(self, sim: Simulation) -> dict:
@@ -497,32 +494,34 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
     return ds
 
 
+def detector_record(case: ConveyorCase, x_star, t, toe, depth, surface, velocity) -> steady.Record:
+    """The detector's quantities from probe samples: depth and surface [m] over h_n, the surface
+    over x* up to the uniform zone's end (zeta_fs's range)."""
+    hn = case.h_n
+    x_detect = np.asarray(x_star) <= case.probes.uniform_zone[1] + 1e-9
+    return steady.Record(np.asarray(t, dtype=float), np.asarray(toe, dtype=float),
+                         np.asarray(depth, dtype=float) / hn, np.asarray(surface, dtype=float)[:, x_detect] / hn,
+                         np.asarray(velocity, dtype=float))
+
 
 def record_of(ds: xr.Dataset, case: ConveyorCase) -> steady.Record:
     """The detector's quantities (``FrontMonitor.record``) from a run's probe series."""
-    hn = case.h_n
-    x_detect = ds["x_star"].values <= case.probes.uniform_zone[1] + 1e-9
-    return steady.Record(ds["time"].values, ds["toe_position"].values, ds["uniform_depth"].values / hn,
-                         ds["surface_elevation"].values[:, x_detect] / hn, ds["velocity_star"].values)
+    return detector_record(case, ds["x_star"].values, ds["time"].values, ds["toe_position"].values,
+                           ds["uniform_depth"].values, ds["surface_elevation"].values, ds["velocity_star"].values)
 
 
-def recorded_case(ds: xr.Dataset, sets: dict | None = None) -> ConveyorCase:
-    """The case a run recorded (``case_yaml``), with ``sets`` ({dotted key: value}) applied; a
+def recorded_case(ds: xr.Dataset, sets=()) -> ConveyorCase:
+    """The case a run recorded (``case_yaml``), with ``sets`` (KEY=VALUE, as --set) applied; a
     record's steady keys that the detection no longer reads are left out, so that an older run
     replays with today's rule (and its own recorded steady.average as W, and min_time)."""
     import yaml
     from dataclasses import fields
+    from .cli import apply_overrides
     from .conveyor import Steady, case_from_dict
     d = yaml.safe_load(ds.attrs["case_yaml"])
     known = {f.name for f in fields(Steady)}
     d["steady"] = {k: v for k, v in (d.get("steady") or {}).items() if k in known}
-    for key, value in (sets or {}).items():
-        node = d
-        *path, last = key.split(".")
-        for k in path:
-            node = node.setdefault(k, {})
-        node[last] = value
-    return case_from_dict(d)
+    return case_from_dict(apply_overrides(d, sets))
 
 
 def replay(ds: xr.Dataset, case: ConveyorCase | None = None, crit: steady.SteadyCriteria | None = None):
@@ -531,7 +530,7 @@ def replay(ds: xr.Dataset, case: ConveyorCase | None = None, crit: steady.Steady
     if case is None:
         case = recorded_case(ds)
     rec = record_of(ds, case)
-    det = steady.SteadyDetector(crit or case.criteria(), case.belt.speed)
+    det = steady.SteadyDetector(crit or case.criteria())
     w = det.crit.window
     for k in range(rec.t.size):
         if det.update(rec.span(rec.t[k] - 2.0 * w - case.probes.interval if k else -math.inf, rec.t[k])):

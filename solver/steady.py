@@ -184,12 +184,6 @@ def front_velocity_fit(t, toe) -> tuple[float, float]:
     return trend_bound(t[last], np.asarray(toe, dtype=float)[last])
 
 
-def _rms(x) -> float:
-    x = np.asarray(x, dtype=float)
-    x = x[np.isfinite(x)]
-    return float(np.sqrt(np.mean(x * x))) if x.size else math.nan
-
-
 def _drift_ratios(ta, ya, tb, yb, window: float, fraction: float) -> tuple[float, float]:
     """(R_D, R_F) of a quantity whose components are the columns of ya (times ta, window A) and
     yb (window B), over the components measured in both windows (module docstring)."""
@@ -207,7 +201,7 @@ def _drift_ratios(ta, ya, tb, yb, window: float, fraction: float) -> tuple[float
     return float(np.sqrt(np.mean(r_d * r_d))), float(np.sqrt(np.mean(r_f * r_f)))
 
 
-def judge(rec: Record, t_end: float, crit: SteadyCriteria, u_b: float) -> Judgement:
+def judge(rec: Record, t_end: float, crit: SteadyCriteria) -> Judgement:
     """The window pair ending at ``t_end``: A = [t_end - 2W, t_end - W], B = (t_end - W, t_end];
     not judged (no drifts: not steady) with fewer than 8 samples in A or 4 in B."""
     w, f = crit.window, crit.fraction
@@ -230,8 +224,8 @@ class SteadyDetector:
     """Judges the window pair ending at each probe time from max(crit.min_time, first sample)
     + 2W on; the first steady pair is the run's (``found``)."""
 
-    def __init__(self, crit: SteadyCriteria, u_b: float):
-        self.crit, self.u_b = crit, u_b
+    def __init__(self, crit: SteadyCriteria):
+        self.crit = crit
         self.found: Judgement | None = None
         self.t_first = math.nan  # the record's first sample time
 
@@ -251,7 +245,7 @@ class SteadyDetector:
         if rec.t.size and math.isnan(self.t_first):
             self.t_first = float(rec.t[0])
         if self.found is None and rec.t.size and rec.t[-1] >= self.earliest_end - 1e-9:
-            j = judge(rec, float(rec.t[-1]), self.crit, self.u_b)
+            j = judge(rec, float(rec.t[-1]), self.crit)
             if j.steady:
                 self.found = j
         return self.found is not None

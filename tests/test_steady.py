@@ -43,7 +43,7 @@ def series(T=12.0, seed=0, depth_drift=0.0, surface_drift=0.0, station_drift=0.0
 
 def first_steady(rec: Record, crit=CRIT):
     """The detector fed sample by sample as the front monitor feeds it: the steady pair, or None."""
-    det = SteadyDetector(crit, U_B)
+    det = SteadyDetector(crit)
     for k in range(rec.t.size):
         sub = Record(rec.t[:k + 1], rec.toe[:k + 1], rec.depth[:k + 1], rec.surface[:k + 1], rec.stations[:k + 1])
         if det.update(sub if k == 0 else sub.span(rec.t[k] - 2.0 * crit.window - DT)):
@@ -97,7 +97,7 @@ def test_a_drift_below_the_fraction_of_its_value_passes_however_small_its_se():
     rec.toe[:] = 0.4
     for k, ok in ((0.5, True), (1.5, False)):
         rec.depth = 1.001 * (1.0 + k * f * rec.t / w)
-        j = judge(rec, 3.0 * w, CRIT, U_B)
+        j = judge(rec, 3.0 * w, CRIT)
         assert j.steady is ok, (k, j.ratios)
 
 
@@ -128,8 +128,9 @@ def monitor_with(rec: Record, stop: bool):
     n = rec.t.size
     m.t = list(rec.t)
     surface = np.full((n, m.x_star.size), np.nan)
-    surface[:, m.x_detect] = np.interp(np.linspace(0, 1, int(m.x_detect.sum())), np.linspace(0, 1, NX),
-                                       SURFACE)[None, :] * hn + (rec.depth[:, None] - 1.001) * hn
+    zone = m.x_star <= m.case.probes.uniform_zone[1] + 1e-9  # the surface the detector watches
+    surface[:, zone] = np.interp(np.linspace(0, 1, int(zone.sum())), np.linspace(0, 1, NX),
+                                 SURFACE)[None, :] * hn + (rec.depth[:, None] - 1.001) * hn
     velocity = np.full((n, m.stations.size, m.z_star.size), 1.0)
     m.series = {"toe": list(rec.toe), "front_position": list(rec.toe), "front_equivalent": list(rec.toe),
                 "uniform_depth": list(rec.depth * hn), "enclosed_area": [1.0] * n, "mass_area": [1.0] * n,

@@ -114,16 +114,16 @@ def start_check_section(ds: xr.Dataset) -> str:
         agree = row["agree"].values
         ok = bool(agree.all())
         moved = [str(m) for m, a in zip(tab["metric"].values, agree) if not a]
-        steady = "" if bool(row["steady"]) else " (<b>not both steady</b>: indicative only)"
+        note = "" if bool(row["steady"]) else " (<b>not both steady</b>: indicative only)"
         ids = list(ds["case"].values)
         since = [float(ds["case_steady_state_time"].values[ids.index(k)]) if "case_steady_state_time" in ds
                  else float("nan") for k in (str(row["own_case"].values), str(c))]
         if all(np.isfinite(since)):
-            steady += f"; averaging windows from {since[0]:.1f} s and {since[1]:.1f} s"
+            note += f"; averaging windows from {since[0]:.1f} s and {since[1]:.1f} s"
         out.append(f"<p><b>{html.escape(str(row['own_case'].values))}</b> against <b>{html.escape(str(c))}</b>: "
                    + ("every metric agrees within 2 se" if ok else f"{len(moved)} of {agree.size} metrics "
                       f"differ by more than 2 se ({html.escape(', '.join(moved))})")
-                   + steady + ".</p>")
+                   + note + ".</p>")
         cells = "".join(
             f"<tr><td class='l'>{html.escape(str(m))}</td>"
             f"<td>{_with_error(row['own'].values[k], row['own_se'].values[k])}</td>"
@@ -190,15 +190,15 @@ VERDICT_CLASS = {"reproduced": "ok", "not reproduced": "warn", "contradicted": "
 def verdict_table(ds: xr.Dataset) -> str:
     """One row per conclusion of the paper: our numbers and the verdict (study.verdict)."""
     from .verdict import PAPER_FINEST_DP, verdicts
+    from .startcheck import pairs
     rows = []
+    notes = {c: holdout_note(ds, i) for i, c in enumerate(ds["case"].values)}
     for v in verdicts(ds):
         caveat = ""
         if v.unsteady:
             caveat = (f"<br><small><b>Rests on {len(v.unsteady)} of {len(v.cases)} runs that are not "
                       f"steady</b> ({html.escape(', '.join(v.unsteady))}): indicative only.</small>")
-        ids = list(ds["case"].values)
-        moved = [f"{c}: {holdout_note(ds, ids.index(c))}" for c in v.cases
-                 if c in ids and holdout_note(ds, ids.index(c)) not in ("none", "no hold-out")]
+        moved = [f"{c}: {notes[c]}" for c in v.cases if notes.get(c, "none") not in ("none", "no hold-out")]
         if moved:
             caveat += ("<br><small>Metrics that moved by more than 2 se from the averaging window to the "
                        "hold-out window after it: " + "; ".join(moved) + ".</small>")
@@ -214,7 +214,7 @@ def verdict_table(ds: xr.Dataset) -> str:
                    '<a href="../docs/numerics.md">docs/numerics.md</a> lists' if schemes != "spec"
                    else "is the paper's as written (docs/scheme.md section 6)")
         check = (" (the start checks, from the paper's start: a block at rest, the belt ramped up from rest)"
-                 if start_check_section(ds) else "")
+                 if pairs(ds) else "")
         start = (f"<p>The runs start from {html.escape(ds.attrs.get('starts', ''))}{check}; their scheme, "
                  f"{html.escape(schemes)}, {departs}.</p>")
     return (start + f"<p>Each conclusion of the paper, judged on this campaign's own runs at its finest dp "
@@ -413,8 +413,9 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
         f"<p>The paper's conclusions are about a Newtonian fluid; this campaign's fluid is "
         f"{html.escape(ds.attrs['rheology'])}, so they are not judged here. Its errors are against "
         "the lubrication reference for that fluid: see Accuracy and cost, and the figures.</p>")
+    start_check = start_check_section(ds)
     body = [("Verdict", verdict), ("Accuracy and cost", accuracy_table(ds)),
-            *([("Start check", start_check_section(ds))] if start_check_section(ds) else []),
+            *([("Start check", start_check)] if start_check else []),
             ("Summary", summary), ("Figures", "".join(figs)), ("Cases", case_table(ds)),
             ("Convergence", convergence_table(ds)), ("Stability", stability_section(ds)),
             *extra_sections, ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
