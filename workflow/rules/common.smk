@@ -5,6 +5,13 @@ from study.config import validate as validate_campaign, cases as campaign_cases,
 from study.grid import CASE_ID
 
 config = validate_campaign(config)  # the schema (with its defaults), then what it cannot check
+FLOW = config.get("flow", "conveyor")  # conveyor, or a flow of study.flowconfig
+if FLOW != "conveyor":
+    from study import flowconfig
+    from study.flowconfig import CASE_ID
+
+    campaign_cases = flowconfig.cases
+    case_dict = flowconfig.scene_dict
 CASES = campaign_cases(config)
 CASE_IDS = [c.id for c in CASES]
 CASE_BY_ID = {c.id: c for c in CASES}
@@ -34,7 +41,15 @@ SOLVER_HASH = source_hash()  # a param of every run: a changed solver reruns the
 import study.metrics, study.reference
 
 # a param of the metrics: new metric code rescores
-METRICS_HASH = files_hash([study.metrics.__file__, study.reference.__file__], names=False)
+if FLOW == "conveyor":
+    METRICS_HASH = files_hash([study.metrics.__file__, study.reference.__file__], names=False)
+    METRIC_KEYS = ("reference", "metrics")
+else:
+    import study.flowcampaign, study.flows.scores, study.flows.measure
+
+    METRICS_HASH = files_hash([study.flowcampaign.__file__, study.flows.scores.__file__,
+                               study.flows.measure.__file__], names=False)
+    METRIC_KEYS = ("scene", "fluids", "metrics")
 
 wildcard_constraints:
     case=CASE_ID,
@@ -47,6 +62,8 @@ def case_yaml(wildcards):
 
 def warm_input(wildcards):
     """The coarser case's run a warm-started case starts from (none without warm_start)."""
+    if FLOW != "conveyor":
+        return []
     src = warm_source(config, CASE_BY_ID[wildcards.case])
     return [run_path(src)] if src is not None else []
 
@@ -55,3 +72,13 @@ def run_priority(wildcards):
     """Finer cases first (cost ~ dp^-3): the longest runs start at once, so that the cores
     finish together instead of one long run starting last."""
     return round(1e-9 / CASE_BY_ID[wildcards.case].dp ** 3, 3)
+
+
+# the solver command of a run: the conveyor front to steady state, or a flow's scene to its end
+if FLOW == "conveyor":
+    RUN_COMMAND = ("NUMBA_NUM_THREADS={threads} python -m solver front {input.case} -o {output} "
+                   "--threads {threads} --quiet --allow-diverged "
+                   "--checkpoint results/checkpoints/{wildcards.case}.ckpt 2> {log}")
+else:
+    RUN_COMMAND = ("NUMBA_NUM_THREADS={threads} python -m solver run {input.case} -o {output} "
+                   "--threads {threads} --quiet --allow-diverged 2> {log}")

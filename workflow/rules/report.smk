@@ -4,12 +4,20 @@ import os
 
 from study.figures import figures_for
 
-FIGURE_SPECS = figures_for(config)
-FIGURES = [spec.name for spec in FIGURE_SPECS]
 FMT = config["figures"]["format"]
 CAPTIONS = os.path.abspath("results/report_captions")  # absolute: Snakemake resolves captions from this file's folder
-for spec in FIGURE_SPECS:  # Snakemake's report reads each caption from a file
-    _write_if_changed(f"{CAPTIONS}/{spec.name}.rst", spec.caption_rst(config["figures"]["profile_ch"]))
+if FLOW == "conveyor":
+    FIGURE_SPECS = figures_for(config)
+    FIGURES = [spec.name for spec in FIGURE_SPECS]
+    for spec in FIGURE_SPECS:  # Snakemake's report reads each caption from a file
+        _write_if_changed(f"{CAPTIONS}/{spec.name}.rst", spec.caption_rst(config["figures"]["profile_ch"]))
+else:
+    from study.flowreport import figures_for as flow_figures
+    from study.figures import rst_text
+
+    FIGURES = [name for name, _, _ in flow_figures(config)]
+    for name, title, caption in flow_figures(config):
+        _write_if_changed(f"{CAPTIONS}/{name}.rst", rst_text(f"{title}. {caption}"))
 
 
 rule figures:

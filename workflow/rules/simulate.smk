@@ -40,6 +40,4 @@ rule run_case:
         runtime=RES["runtime_min"],
         mem_mb=RES["mem_mb"],
     shell:
-        "NUMBA_NUM_THREADS={threads} python -m solver front {input.case} -o {output} "
-        "--threads {threads} --quiet --allow-diverged "
-        "--checkpoint results/checkpoints/{wildcards.case}.ckpt 2> {log}"
+        RUN_COMMAND

@@ -11,9 +11,16 @@ def _cfg(path):
     return load(path)
 
 
+def _flow(cfg) -> bool:
+    """Whether the campaign is a flow other than the conveyor (study.flowconfig)."""
+    return cfg.get("flow", "conveyor") != "conveyor"
+
+
 def cmd_validate(a):
     from .config import cases
     cfg = _cfg(a.config)
+    if _flow(cfg):
+        from .flowconfig import cases
     cs = cases(cfg)
     print(f"{a.config}: valid, {len(cs)} cases")
     for c in cs:
@@ -24,6 +31,8 @@ def cmd_case_file(a):
     import yaml
     from .config import case_dict, cases
     cfg = _cfg(a.config)
+    if _flow(cfg):
+        from .flowconfig import cases, scene_dict as case_dict
     match = [c for c in cases(cfg) if c.id == a.case]
     if not match:
         raise SystemExit(f"error: case {a.case!r} is not in {a.config}")
@@ -54,6 +63,11 @@ def cmd_metrics(a):
     cfg = _cfg(a.config)
     with xr.open_dataset(a.run) as run:
         run = run.load()
+    if _flow(cfg):
+        from .flowcampaign import case_by_id, score
+        m = score(cfg, case_by_id(cfg, Path(a.run).parent.name), run)
+        write_atomic(m, a.output)
+        return
     case = recorded_case(run) or solver_case(cfg)  # each run against its own physics
     ref, measured = _reference(cfg, case)
     m = case_metrics(run, ref, tuple(cfg["metrics"]["free_surface_x_star"]), measured)
@@ -67,6 +81,13 @@ def cmd_reduce(a):
     from .campaign import build
     from .config import cases, solver_case
     cfg = _cfg(a.config)
+    if _flow(cfg):
+        import yaml
+        from .flowcampaign import reduce
+        ds = reduce(cfg, Path(a.results))
+        ds.attrs["config_yaml"] = yaml.safe_dump(cfg, sort_keys=False)
+        write_atomic(ds, a.output)
+        return
     cs = cases(cfg)
     runs, metrics = [], []
     for c in cs:
@@ -115,6 +136,11 @@ def cmd_figures(a):
     f = cfg["figures"]
     with xr.open_dataset(a.campaign) as ds:
         ds = ds.load()
+    if _flow(cfg):
+        from .flowreport import write_figures
+        for p in write_figures(cfg, ds, a.outdir, fmt=f["format"], dpi=f["dpi"]):
+            print(p)
+        return
     for p in write_all(ds, a.outdir, _figure_settings(cfg, ds), fmt=f["format"], dpi=f["dpi"],
                        specs=figures_for(cfg)):
         print(p)
@@ -129,6 +155,11 @@ def cmd_report(a):
     f = cfg["figures"]
     with xr.open_dataset(a.campaign) as ds:
         ds = ds.load()
+    if _flow(cfg):
+        from .flowreport import render as render_flow
+        write(render_flow(cfg, ds, a.figures, yaml.safe_dump(cfg, sort_keys=False)), a.output)
+        print(a.output)
+        return
     settings = _figure_settings(cfg, ds)
     figs = []
     for spec in figures_for(cfg):

@@ -84,8 +84,19 @@ def _message(err) -> str:
 def validate(config: dict) -> dict:
     """Validate against the JSON schema (filling defaults) and check what a schema cannot.
 
-    Returns the config with defaults; raises ConfigError naming the key.
+    Returns the config with defaults; raises ConfigError naming the key. A campaign whose
+    ``flow`` is not the conveyor has its own schema (study.flowconfig).
     """
+    from .flowconfig import FLOWS, FlowConfigError
+    flow = config.get("flow", "conveyor") if isinstance(config, dict) else "conveyor"
+    if flow not in FLOWS:
+        raise ConfigError(f"config key flow: {flow!r} is not one of {', '.join(FLOWS)}")
+    if flow != "conveyor":
+        from . import flowconfig
+        try:
+            return flowconfig.validate(config)
+        except FlowConfigError as exc:
+            raise ConfigError(str(exc)) from None
     import jsonschema
     schema = load_schema()
     cfg = coerce_scalars(copy.deepcopy(config), schema)

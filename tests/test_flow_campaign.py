@@ -1,0 +1,181 @@
+"""Campaigns of the flows beyond the conveyor: config validation, the scenes they build, the
+scores against exact fields, and a miniature film campaign end to end."""
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from study.config import ConfigError, validate
+from study.flowconfig import cases, scene_dict
+from study.flows import film, scores, slump
+
+ROOT = Path(__file__).resolve().parent.parent
+G = 9.81
+
+
+def config(name):
+    with open(ROOT / "config" / f"{name}.yaml") as fh:
+        return yaml.safe_load(fh)
+
+
+# ---- configuration -----------------------------------------------------------
+
+def test_an_unknown_flow_is_refused_with_the_allowed_ones():
+    with pytest.raises(ConfigError, match="config key flow: 'dambreak' is not one of conveyor, slump, film, user"):
+        validate({"flow": "dambreak"})
+
+
+@pytest.mark.parametrize("change, match", [
+    (lambda c: c["scene"].pop("height"), r"scene.height: required for flow slump \(release height H0, m\)"),
+    (lambda c: c["scene"].update(width=0.1), r"scene.width: not a key of flow slump; its keys are height"),
+    (lambda c: c["scene"].update(end_time="soon"), r"scene.end_time: 'soon' is not valid"),
+    (lambda c: c.pop("fluids"), r"config key fluids: flow slump needs at least one fluid"),
+    (lambda c: c["grid"].update(scheme=["dualsphysics"]), r"grid.scheme.0: 'dualsphysics' is not one of"),
+    (lambda c: c["fluids"]["newtonian"].update(viscosity=-1.0), r"config key fluids.newtonian: .*viscosity"),
+])
+def test_a_bad_slump_config_names_its_key(change, match):
+    cfg = config("slump")
+    change(cfg)
+    with pytest.raises(ConfigError, match=match):
+        validate(cfg)
+
+
+def test_a_number_written_1e_3_is_read_as_a_number():
+    cfg = config("film")
+    cfg["grid"]["dp"] = ["2e-3"]
+    cfg["scene"]["depth"] = "2e-2"
+    v = validate(cfg)
+    assert v["grid"]["dp"] == [0.002] and v["scene"]["depth"] == 0.02
+
+
+def test_a_malformed_user_reference_is_refused_with_its_line(tmp_path, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    bad = tmp_path / "u.csv"
+    bad.write_text("x, z, u\n2.5e-4, 0.0001, 1e-6\n2.5e-4, abc, 2e-6\n")
+    cfg = config("user")
+    cfg["scene"]["reference"] = {"velocity": str(bad)}
+    line3 = r"scene.reference.velocity: .*u.csv line 3: 'abc' in column z is not a number"
+    with pytest.raises(ConfigError, match=line3):
+        validate(cfg)
+    cfg["scene"]["reference"] = {"speed": str(bad)}
+    kinds = "scene.reference.speed: not a kind of reference; allowed: front, depth, velocity"
+    with pytest.raises(ConfigError, match=kinds):
+        validate(cfg)
+
+
+def test_the_slump_scene_is_the_two_sided_release_on_a_bed_past_the_reference_front():
+    cfg = validate(config("slump"))
+    by_id = {c.id: c for c in cases(cfg)}
+    assert len(by_id) == 12  # 3 dp x 2 schemes x 2 fluids
+    sc = scene_dict(cfg, by_id["dp2mm_ch1.5_skillen_surge_newtonian"])
+    assert sc["fluid"]["blocks"] == [{"x": [-0.1, 0.1], "z": [0.0, 0.05]}]
+    x_ref = slump.front_position(5.0, 0.05 * 0.1, 5.6 / 1383.0, G)
+    assert sc["walls"][0]["x"][1] >= 1.3 * x_ref
+    # spec with a yield-stress fluid: the paper's scheme with the implicit laminar term
+    spec = scene_dict(cfg, by_id["dp2mm_ch1.5_skillen_spec_bingham"])["numerics"]
+    assert spec["viscous_update"] == "implicit" and "volume_relaxation" not in spec
+    surge = scene_dict(cfg, by_id["dp2mm_ch1.5_skillen_surge_newtonian"])["numerics"]
+    assert surge["viscous_update"] == "substepped" and surge["shifting"]["method"] == "skillen"
+
+
+# ---- scores against exact fields ----------------------------------------------
+
+def fake_run(times, frames, dp):
+    """A run dataset as solver.output writes it, from frames of (x, z, u) fluid arrays."""
+    n = max(len(f[0]) for f in frames)
+    arr = {k: np.full((len(frames), n), np.nan) for k in ("x", "z", "u")}
+    kind = np.ones((len(frames), n), dtype=np.int8)
+    for k, (x, z, u) in enumerate(frames):
+        arr["x"][k, :len(x)], arr["z"][k, :len(x)], arr["u"][k, :len(x)] = x, z, u
+        kind[k, :len(x)] = 0
+    data = {k: (("snapshot", "particle"), v) for k, v in arr.items()}
+    data["kind"] = (("snapshot", "particle"), kind)
+    return xr.Dataset(data, coords={"snapshot_time": ("snapshot", np.asarray(times))},
+                      attrs={"dp": dp, "status": "completed", "scene_yaml": "periodic_x: null\n"})
+
+
+def similarity_particles(t, A, nu, dp, scale=1.0):
+    """Particle centres filling the similarity profile (both sides), the front stretched by ``scale``."""
+    xn = scale * float(slump.front_position(t, A, nu, G))
+    xs = np.arange(-xn + dp / 2, xn, dp)
+    px, pz = [], []
+    for x in xs:
+        h = float(slump.depth_profile(x / scale, t, A, nu, G))
+        for z in np.arange(dp / 2, h, dp):
+            px.append(x)
+            pz.append(z)
+    return np.array(px), np.array(pz), np.zeros(len(px))
+
+
+@pytest.mark.parametrize("scale, expected", [(1.0, 0.0), (1.05, 0.05)])
+def test_the_slump_front_error_and_exponent_of_a_similarity_current(scale, expected):
+    """Particles filling the similarity current (front = outermost centre + dp / 2 within dp / 2
+    of x_N): front error below 0.4 % and exponent within 1 % of 1/5; stretched by 5 %: 5 %."""
+    H0, L0, nu, dp = 0.05, 0.1, 4e-3, 5e-4
+    times = np.arange(0.0, 5.01, 0.25)
+    frames = [similarity_particles(max(t, 0.05), H0 * L0, nu, dp, scale) for t in times]
+    s = scores.slump_newtonian(fake_run(times, frames, dp), H0, L0, nu, 0.02)
+    assert s["front_error"] == pytest.approx(expected, abs=4e-3)
+    assert abs(s["exponent"] / 0.2 - 1) < 0.01
+    if scale == 1.0:
+        assert s["depth_error"] < 0.03  # the depth resolved to dp = 1 % of the depth at the plane
+
+
+def test_a_front_that_stops_is_found_stopped_and_one_that_creeps_is_not():
+    t = np.arange(0.0, 5.0, 0.05)
+    # speed 0.2 exp(-t / 0.5) m/s: below 1 mm/s from t = 2.65 s; a line over the 0.5 s before t
+    # measures about the speed at t - 0.25 s, so the stop is found at about 2.9 s
+    stopping = 0.3 - 0.1 * np.exp(-t / 0.5)
+    t_s = scores.stop_time(t, stopping, 1e-3, 0.5)
+    assert 2.85 <= t_s <= 3.0
+    creeping = 0.3 + 2e-3 * t
+    assert math.isnan(scores.stop_time(t, creeping, 1e-3, 0.5))
+
+
+@pytest.mark.parametrize("offset, expected", [(0.0, 0.0), (0.01, 0.01)])
+def test_the_film_profile_error_of_the_exact_series(offset, expected):
+    h, nu, theta, dp = 0.02, 4e-3, math.radians(15.3), 1e-3
+    z = np.repeat(np.arange(dp / 2, h, dp), 4)
+    x = np.tile(np.arange(4) * dp, z.size // 4)
+    um = film.u_max(h, nu, G, theta)
+    times = [0.0, 0.05, 0.1]
+    frames = [(x, z, film.velocity(z, t, h, nu, G, theta) + offset * um) for t in times]
+    s = scores.film_startup(fake_run(times, frames, dp), h, nu, theta)
+    assert s["profile_error"] == pytest.approx(expected, abs=1e-9)
+
+
+def test_rms_with_se_of_noise_about_a_constant():
+    rng = np.random.default_rng(1)
+    d = 0.05 + 0.002 * rng.standard_normal(400)
+    rms, se = scores.rms_with_se(np.arange(400.0), d)
+    assert rms == pytest.approx(0.05, rel=0.01)
+    assert 0.5 * 0.002 / 20 < se < 2 * 0.002 / 20  # sd / sqrt(n)
+
+
+# ---- a miniature film campaign end to end -------------------------------------
+
+@pytest.mark.slow
+def test_a_film_campaign_runs_end_to_end_and_reports_its_answer(tmp_path):
+    cfg = config("film")
+    cfg["scene"].update(end_time=0.05, output_interval=0.025)
+    cfg["grid"]["dp"] = [4e-3, 2.5e-3]
+    path = tmp_path / "film.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--configfile",
+                        str(path), "--cores", "2"], cwd=tmp_path, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr[-4000:]
+    ds = xr.load_dataset(tmp_path / "results" / "campaign.nc")
+    assert list(ds["case"].values) == ["dp4mm_ch1.5_skillen_surge_newtonian", "dp2.5mm_ch1.5_skillen_surge_newtonian",
+                                       "dp4mm_ch1.5_skillen_spec_newtonian", "dp2.5mm_ch1.5_skillen_spec_newtonian"]
+    assert np.all(ds["status"].values == "completed")
+    assert np.all(np.isfinite(ds["profile_error"].values)) and np.all(ds["profile_error"].values < 0.1)
+    html = (tmp_path / "reports" / "report.html").read_text()
+    for section in ("Answer", "Accuracy and cost", "Convergence", "Stability", "Run time against error"):
+        assert section in html
+    assert "Verdict" not in html and "Where the plug is" not in html
+    assert "newtonian</b>: surge's velocity profile error at dp = 2.5 mm is" in html
