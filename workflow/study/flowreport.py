@@ -44,14 +44,15 @@ def reference_text(cfg: dict, ds: xr.Dataset) -> str:
                  "x_N is the outermost fluid particle plus dp / 2.</p><ul>"]
         for name, fl in (cfg.get("fluids") or {}).items():
             if fc.newtonian(fl):
+                f = cfg["metrics"]["memory_fraction"]
                 t_c = float(np.nanmax(ds["compare_from"].values)) if "compare_from" in ds else math.nan
                 lines.append(
                     f"<li><b>{html.escape(name)}</b> (nu = {fl['viscosity'] / fl['density']:.4g} m2/s): "
                     "Huppert's similarity solution (J. Fluid Mech. 121, 1982), x_N = 1.411 (g A^3 t / (3 nu))^(1/5) "
                     "and its depth profile. The release's memory has faded, and the runs are compared, from "
                     f"t_c = {t_c:.3g} s: the time past which lubrication theory started from the rectangle has "
-                    f"its front's local exponent within {100 * cfg['metrics']['memory_fraction']:.3g} % of 1/5 "
-                    "(and its front within 0.5 % of the similarity front). Front error: RMS of x_N / x_ref - 1 "
+                    f"its front's local exponent within {100 * f:.3g} % of 1/5 (and its front within "
+                    f"{100 * ((1 - f) ** -0.2 - 1):.2g} % of the similarity front). Front error: RMS of x_N / x_ref - 1 "
                     "over the snapshots from t_c; exponent: the least-squares slope of ln x_N against ln t "
                     "over the same snapshots; depth profile: the last snapshot, RMS over x &le; 0.95 x_N "
                     "over the reference's depth at the plane.</li>")
