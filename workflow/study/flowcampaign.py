@@ -19,7 +19,10 @@ ERRORS = {
     ("film", True): ("profile_error",),
     ("user", True): ("front_error", "depth_error", "velocity_error"),
 }
+# the measured quantity whose convergence the GCI states (Celik et al. 2008), per flow and fluid
+QUANTITIES = {("slump", True): ("front_final",), ("slump", False): ("runout",)}
 LABELS = {
+    "front_final": "front x_N at the end", "runout": "runout",
     "front_error": "front x_N", "exponent_error": "exponent of x_N (t)", "depth_error": "depth profile",
     "runout_error": "runout", "shape_error": "arrested shape", "profile_error": "velocity profile",
     "velocity_error": "velocity profiles",

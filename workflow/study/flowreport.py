@@ -52,9 +52,9 @@ def reference_text(cfg: dict, ds: xr.Dataset) -> str:
                     "and its depth profile. The release's memory has faded, and the runs are compared, from "
                     f"t_c = {t_c:.3g} s: the time past which lubrication theory started from the rectangle has "
                     f"its front's local exponent within {100 * f:.3g} % of 1/5 (and its front within "
-                    f"{100 * ((1 - f) ** -0.2 - 1):.2g} % of the similarity front). Front error: RMS of x_N / x_ref - 1 "
-                    "over the snapshots from t_c; exponent: the least-squares slope of ln x_N against ln t "
-                    "over the same snapshots; depth profile: the last snapshot, RMS over x &le; 0.95 x_N "
+                    f"{100 * ((1 - f) ** -0.2 - 1):.2g} % of the similarity front). Front error: RMS of "
+                    "x_N / x_ref - 1 over the snapshots from t_c; exponent: the least-squares slope of ln x_N "
+                    "against ln t over the same snapshots; depth profile: the last snapshot, RMS over x &le; 0.95 x_N "
                     "over the reference's depth at the plane.</li>")
             else:
                 ratio = reference_runout(cfg, fl) / s["height"]
@@ -167,10 +167,25 @@ def convergence_table(cfg: dict, ds: xr.Dataset) -> str:
                         f"<td class='l'>{', '.join(_mm(ds['dp'].values[i]) for i in idx)}</td>"
                         f"<td class='l'>{', '.join(vals)}</td><td class='l'>{fc.falls_with_dp(ds[e].values[idx])}</td>"
                         f"<td class='l'>{g.status}</td><td>{order}</td><td>{limit}</td></tr>")
+    for seq in fc.sequences(ds):
+        fl = fluids.get(seq["fluid"]) or None
+        for q in fc.QUANTITIES.get((cfg["flow"], fl is None or fc.newtonian(fl)), ()):
+            idx = seq["cases"]
+            g = fc.convergence(ds, q, idx)
+            reliable = g.status == "monotone" and 0.5 <= g.order <= 4
+            rows.append(f"<tr><td class='l'>{html.escape(_series_label(seq))}</td><td class='l'>{fc.LABELS[q]}</td>"
+                        f"<td class='l'>{', '.join(_mm(ds['dp'].values[i]) for i in idx)}</td>"
+                        f"<td class='l'>{', '.join(f'{1000 * ds[q].values[i]:.4g} mm' for i in idx)}</td>"
+                        f"<td class='l'>&ndash;</td><td class='l'>{g.status}</td>"
+                        f"<td>{f'{g.order:.2g}' if g.status == 'monotone' else '&ndash;'}"
+                        f"{'' if reliable or g.status != 'monotone' else ' (unreliable)'}</td>"
+                        f"<td>{f'{1000 * g.extrapolated:.4g} mm, GCI {percent(g.gci_fine)}' if reliable else '&ndash;'}"
+                        "</td></tr>")
     return ("<p>Each error's magnitude over falling dp; from the three finest dp, where they converge "
             "monotonically, the observed order and the error Richardson-extrapolated to dp &rarr; 0 (Celik et al. "
             "2008): near 0 where the runs converge to the reference, away from it where the scheme's limit differs "
-            "from the reference (or the reference from the flow). An order above 4 or below 0.5 is flagged "
+            "from the reference (or the reference from the flow). For the measured front and runout: their "
+            "extrapolated value and the fine grid's GCI. An order above 4 or below 0.5 is flagged "
             "unreliable and nothing is extrapolated from it.</p><table><tr><th class='l'>sequence</th>"
             "<th class='l'>error</th><th class='l'>dp</th><th class='l'>values</th><th class='l'>with dp</th>"
             "<th class='l'>convergence</th><th>order</th><th>error at dp &rarr; 0</th></tr>"
@@ -178,11 +193,26 @@ def convergence_table(cfg: dict, ds: xr.Dataset) -> str:
 
 
 def stability_text(ds: xr.Dataset) -> str:
-    bad = [i for i in range(ds.sizes["case"]) if str(ds["status"].values[i]) != "completed"]
-    if not bad:
-        return f"<p>All {ds.sizes['case']} runs completed: none diverged.</p>"
-    return "<ul>" + "".join(f"<li>{html.escape(str(ds['case'].values[i]))}: {html.escape(str(ds['status'].values[i]))}"
-                            f" ({html.escape(str(ds['reason'].values[i]))})</li>" for i in bad) + "</ul>"
+    """The stability map: each sequence's status at each dp (diverged cells with their reason)."""
+    dps = sorted({float(d) for d in ds["dp"].values}, reverse=True)
+    head = "<tr><th class='l'>sequence</th>" + "".join(f"<th>{_mm(d)}</th>" for d in dps) + "</tr>"
+    rows = []
+    for seq in fc.sequences(ds):
+        by_dp = {float(ds["dp"].values[i]): i for i in seq["cases"]}
+        cells = []
+        for d in dps:
+            i = by_dp.get(d)
+            if i is None:
+                cells.append("<td></td>")
+                continue
+            status = str(ds["status"].values[i])
+            reason = f": {html.escape(str(ds['reason'].values[i]))}" if ds["reason"].values[i] else ""
+            cells.append(f"<td class='{'ok' if status == 'completed' else 'bad'}'>{html.escape(status)}{reason}</td>")
+        rows.append(f"<tr><td class='l'>{html.escape(_series_label(seq))}</td>{''.join(cells)}</tr>")
+    n_bad = sum(str(s) != "completed" for s in ds["status"].values)
+    lead = (f"<p>All {ds.sizes['case']} runs completed: none diverged.</p>" if not n_bad else
+            f"<p>{n_bad} of {ds.sizes['case']} runs did not complete; they have no errors.</p>")
+    return lead + f"<table>{head}{''.join(rows)}</table>"
 
 
 # ---- figures ---------------------------------------------------------------
