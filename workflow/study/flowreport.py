@@ -74,7 +74,7 @@ def reference_text(cfg: dict, ds: xr.Dataset) -> str:
                 "and no stress at the surface. Error: at every snapshot after t = 0 the RMS over the fluid "
                 "particles of (u - u_exact) / u_max; the largest over the snapshots is reported.</p>")
     refs = ", ".join(f"{k}: {html.escape(str(v))}" for k, v in s["reference"].items())
-    return (f"<p>Scene {html.escape(s['file'])}; reference files {refs} (docs/flows.md gives their format). "
+    return (f"<p>Scene {html.escape(s['file'])}; reference files {refs} (docs/flow-user.md gives their format). "
             f"Front error: RMS of x_N / x_ref - 1 over the reference times from {s['front_from']:g} s; a depth "
             "profile at its time, a velocity profile at its station at the run's last snapshot, each as the "
             "RMS of the difference over the reference's largest value; a kind's error is the RMS over its "

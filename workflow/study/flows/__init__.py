@@ -1,11 +1,12 @@
-"""Reference solutions of flows other than the conveyor front, and a reader for a user's own
-reference data (docs/flows.md). Pure functions over numbers, arrays and xarray objects:
+"""The flows beyond the conveyor front (docs/flows.md): their references, what a run's
+snapshots say about them, and a run's errors. Pure functions over numbers, arrays and xarray
+objects:
 
-  slump  a 2D gravity current released from a rectangle on a horizontal bed: Huppert's
-         viscous similarity solution, and the arrested shape of a yield-stress fluid
-  film   start-up from rest of a film on an incline
-  user   front positions and depth or velocity profiles read from CSV files, and the
-         errors of a run against them
-
-Not yet used by the campaign (Snakefile, workflow/rules) or the solver.
+  slump    a 2D gravity current released from a rectangle on a horizontal bed: Huppert's
+           viscous similarity solution, and the arrested shape of a yield-stress fluid
+  film     start-up from rest of a film on an incline
+  user     front positions and depth or velocity profiles read from CSV files, and the
+           errors of a run against them
+  measure  the front, depth and velocity profiles of a scene run's snapshots
+  scores   each flow's errors with their sampling errors (study.flowcampaign calls them)
 """

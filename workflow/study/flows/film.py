@@ -1,4 +1,4 @@
-"""Start-up from rest of a film on an incline (docs/flows.md).
+"""Start-up from rest of a film on an incline (docs/flow-film.md).
 
 A film of depth h on a plane inclined at theta, at rest at t = 0: no slip at z = 0, a free
 surface (u_z = 0) at z = h, z normal to the plane:

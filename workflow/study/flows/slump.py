@@ -1,4 +1,4 @@
-"""A 2D gravity current from a rectangular release on a horizontal no-slip bed (docs/flows.md).
+"""A 2D gravity current from a rectangular release on a horizontal no-slip bed (docs/flow-slump.md).
 
 The release, height H0 and length L0, rests against a free-slip end wall at x = 0, the
 symmetry plane of a two-sided release; A = H0 L0 is the area per unit width of this half.

@@ -1,4 +1,4 @@
-"""A user's reference data from CSV files, and a run's error against it (docs/flows.md).
+"""A user's reference data from CSV files, and a run's error against it (docs/flow-user.md).
 
 Three formats, one kind of data a file, comma-separated, SI units:
 
