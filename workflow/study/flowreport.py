@@ -31,7 +31,7 @@ def _series_label(seq) -> str:
 
 
 def _mm(dp) -> str:
-    return f"{1000 * float(dp):.3g} mm"
+    return f"{1000 * float(dp):.4g} mm"
 
 
 def reference_text(cfg: dict, ds: xr.Dataset) -> str:
@@ -217,11 +217,14 @@ def stability_text(ds: xr.Dataset) -> str:
 
 # ---- figures ---------------------------------------------------------------
 
-def _plain_log(ax, axis="both"):
-    fmt = matplotlib.ticker.FuncFormatter(lambda v, _p: f"{v:g}")
-    for a in ((ax.xaxis, ax.yaxis) if axis == "both" else (ax.yaxis,) if axis == "y" else (ax.xaxis,)):
-        a.set_major_formatter(fmt)
-        a.set_minor_formatter(fmt if a is ax.xaxis else matplotlib.ticker.NullFormatter())
+def _plain_log(ax):
+    """Log axes whose every tick label is a plain number (study.figures' rule)."""
+    from .figures import _PlainLogFormatter, _plain
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    for a in (ax.xaxis, ax.yaxis):
+        a.set_major_formatter(matplotlib.ticker.FuncFormatter(_plain))
+        a.set_minor_formatter(_PlainLogFormatter(_plain))
 
 
 def fig_errors(cfg: dict, ds: xr.Dataset):
@@ -229,44 +232,43 @@ def fig_errors(cfg: dict, ds: xr.Dataset):
     errs = []
     for fl in fluids.values():
         errs += [e for e in fc.errors_of(cfg, fl or None) if e not in errs]
+    from .figures import _log_axes
     fig, axes = plt.subplots(1, len(errs), figsize=(4.2 * len(errs), 3.6), squeeze=False)
     for ax, e in zip(axes[0], errs):
+        drawn = False
         for seq in fc.sequences(ds):
             idx = [i for i in seq["cases"] if np.isfinite(ds[e].values[i])]
             if not idx:
                 continue
-            dp = 1000 * ds["dp"].values[idx]
-            v = 100 * np.abs(ds[e].values[idx])
-            se = 200 * ds[f"{e}_se"].values[idx] if f"{e}_se" in ds else None
-            ax.errorbar(dp, v, yerr=se, marker="o", capsize=3, label=_series_label(seq))
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.invert_xaxis()
-        _plain_log(ax)
-        ax.set_xlabel("particle spacing dp [mm]")
-        ax.set_ylabel(f"|{fc.LABELS[e]} error| [%]")
-        ax.axhline(100 * cfg["metrics"]["tolerance"], color="0.6", ls=":", lw=1)
+            se = 2 * ds[f"{e}_se"].values[idx] if f"{e}_se" in ds else None
+            ax.errorbar(1000 * ds["dp"].values[idx], np.abs(ds[e].values[idx]), yerr=se, marker="o", capsize=3,
+                        label=_series_label(seq))
+            drawn = True
+        _log_axes(ax, drawn, dp_ticks=sorted({1000 * float(d) for d in ds["dp"].values}))
+        ax.set_ylabel(f"|{fc.LABELS[e]} error|")
+        ax.axhline(cfg["metrics"]["tolerance"], color="0.6", ls=":", lw=1)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=7)
+        if drawn:
+            ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
 
 
 def fig_cost(cfg: dict, ds: xr.Dataset):
+    from .figures import _log_axes
     fig, ax = plt.subplots(figsize=(5.5, 4))
     fluids = fc.fluid_dicts(cfg)
+    drawn = False
     for seq in fc.sequences(ds):
         head = fc.errors_of(cfg, fluids.get(seq["fluid"]) or None)[0]
         idx = [i for i in seq["cases"] if np.isfinite(ds[head].values[i])]
         if idx:
-            ax.plot(ds["wall_time_s"].values[idx], 100 * np.abs(ds[head].values[idx]), marker="o",
+            ax.plot(ds["wall_time_s"].values[idx], np.abs(ds[head].values[idx]), marker="o",
                     label=f"{_series_label(seq)} ({fc.LABELS[head]})")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    _plain_log(ax)
-    ax.set_xlabel("run wall time [s]")
-    ax.set_ylabel("headline error [%]")
-    ax.axhline(100 * cfg["metrics"]["tolerance"], color="0.6", ls=":", lw=1)
+            drawn = True
+    _log_axes(ax, drawn, xlabel="run wall time [s]", invert_x=False)
+    ax.set_ylabel("|headline error|")
+    ax.axhline(cfg["metrics"]["tolerance"], color="0.6", ls=":", lw=1)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()
@@ -294,9 +296,8 @@ def fig_fronts(cfg: dict, ds: xr.Dataset):
                     "k--", lw=1.5, label="similarity (Huppert 1982)")
             if "compare_from" in ds:
                 ax.axvline(float(np.nanmax(ds["compare_from"].values)), color="0.5", ls=":", lw=1)
-            ax.set_xscale("log")
-            ax.set_yscale("log")
             _plain_log(ax)
+            ax.set_xlim(left=max(0.1, float(t.min())))
         elif cfg["flow"] == "slump":
             ax.axhline(1000 * reference_runout(cfg, fl), color="k", ls="--", lw=1.5, label="lubrication runout")
         ax.set_xlabel("t [s]")

@@ -59,10 +59,12 @@ def slump_newtonian(ds, H0: float, L0: float, nu: float, memory_fraction: float)
     if late.sum() < 3:
         return out | {"front_error": math.nan, "front_error_se": math.nan, "front_final_error": math.nan,
                       "exponent": math.nan, "exponent_se": math.nan, "exponent_error": math.nan,
+                      "exponent_error_se": math.nan,
                       "depth_error": math.nan, "depth_error_se": math.nan}
     out |= _front_scores(t, x, t[late], slump.front_position(t[late], A, nu, G))
     b, b_se = slump.fit_front_exponent(t, x, (t_c, math.inf))
-    out |= {"exponent": b, "exponent_se": b_se, "exponent_error": b / slump.SIMILARITY_EXPONENT - 1.0}
+    out |= {"exponent": b, "exponent_se": b_se, "exponent_error": b / slump.SIMILARITY_EXPONENT - 1.0,
+            "exponent_error_se": b_se / slump.SIMILARITY_EXPONENT}
     k = ds.sizes["snapshot"] - 1
     xn = float(slump.front_position(t[k], A, nu, G))
     xs = np.linspace(0.0, 0.95 * xn, 40)
