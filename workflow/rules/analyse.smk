@@ -4,7 +4,7 @@ rule metrics:
     output:
         "results/cases/{case}/metrics.nc",
     params:
-        settings=lambda wc: yaml.safe_dump({k: config[k] for k in METRIC_KEYS}),
+        settings=lambda wc: yaml.safe_dump({k: config.get(k) for k in METRIC_KEYS}),
         code=METRICS_HASH,
         config=CONFIG_FILE,
     log:
