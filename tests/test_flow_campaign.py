@@ -137,6 +137,21 @@ def test_a_front_that_stops_is_found_stopped_and_one_that_creeps_is_not():
     assert math.isnan(scores.stop_time(t, creeping, 1e-3, 0.5))
 
 
+@pytest.mark.parametrize("shift", [1.0, 1.05])
+def test_a_user_front_reference_scores_a_symmetric_release(tmp_path, shift):
+    """The similarity current as a run, its front written as a user's CSV (raised by ``shift``):
+    the user flow's front error is the shift (to 0.4 %, the front's dp / 2 granularity)."""
+    from study.flows.user import read_front
+    H0, L0, nu, dp = 0.05, 0.1, 4e-3, 5e-4
+    times = np.arange(0.25, 5.01, 0.25)
+    run = fake_run(times, [similarity_particles(t, H0 * L0, nu, dp) for t in times], dp)
+    path = tmp_path / "front.csv"
+    x_ref = shift * slump.front_position(times, H0 * L0, nu, G)
+    path.write_text("t, x_front\n" + "".join(f"{t:g}, {x:.6g}\n" for t, x in zip(times, x_ref)))
+    s = scores.user_scores(run, {"front": read_front(path)}, 1.0, True)
+    assert s["front_error"] == pytest.approx(1 - 1 / shift, abs=4e-3)
+
+
 @pytest.mark.parametrize("offset, expected", [(0.0, 0.0), (0.01, 0.01)])
 def test_the_film_profile_error_of_the_exact_series(offset, expected):
     h, nu, theta, dp = 0.02, 4e-3, math.radians(15.3), 1e-3

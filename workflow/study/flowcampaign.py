@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .flowconfig import G, FlowCase, cases, fluid_of, read_references, scene_dict
+from .flowconfig import G, FlowCase, cases, fluid_of, read_references, scene_dict  # noqa: F401 (G for callers)
 from .flows import scores
 
 # each flow's errors, the headline first (an error is a fraction; each has an _se)
@@ -172,7 +172,6 @@ def cheapest(ds: xr.Dataset, idx, errs, tolerance: float) -> int | None:
 
 
 def fluid_dicts(cfg: dict) -> dict:
-    return {name: f for name, f in (cfg.get("fluids") or {"": {}}).items()}
+    """name -> fluid of the campaign; a user flow's one unnamed fluid ({"": {}}) is its scene's."""
+    return dict(cfg.get("fluids") or {"": {}})
 
-
-__all__ = ["score", "reduce", "sequences", "convergence", "cheapest", "errors_of", "LABELS", "G"]

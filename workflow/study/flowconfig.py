@@ -103,8 +103,8 @@ def _scene_keys(cfg: dict) -> None:
         if k not in keys:
             raise FlowConfigError(f"config key scene.{k}: not a key of flow {flow}; its keys are "
                                   + ", ".join(f"{n} ({d[2]})" for n, d in keys.items()))
+    from .config import coerce_scalars
     for name, (default, check, what) in keys.items():
-        from .config import coerce_scalars
         if name in scene:
             scene[name] = coerce_scalars(scene[name], {"type": ["number", "boolean"]})
             if not (scene[name] is None and default is None) and not check(scene[name]):

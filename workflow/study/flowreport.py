@@ -16,9 +16,9 @@ import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
 from . import flowcampaign as fc  # noqa: E402
-from .flowconfig import fluid_of, reference_runout  # noqa: E402
+from .flowconfig import read_references, reference_runout  # noqa: E402
 from .numbers import percent  # noqa: E402
-from .report import CSS, _commit, _with_error, write  # noqa: E402
+from .report import CSS, _commit, _with_error  # noqa: E402
 
 FLOW_TITLES = {"slump": "a viscous gravity current from a rectangular release (slump)",
                "film": "the start-up from rest of a film on an incline",
@@ -300,6 +300,9 @@ def fig_fronts(cfg: dict, ds: xr.Dataset):
             ax.set_xlim(left=max(0.1, float(t.min())))
         elif cfg["flow"] == "slump":
             ax.axhline(1000 * reference_runout(cfg, fl), color="k", ls="--", lw=1.5, label="lubrication runout")
+        else:  # a user's front reference
+            ref = read_references(s)["front"]
+            ax.plot(ref["t"], 1000 * ref, "ko", ms=4, label="reference (CSV)")
         ax.set_xlabel("t [s]")
         ax.set_ylabel("front x_N [mm]")
         ax.set_title(name, fontsize=9)
@@ -317,11 +320,12 @@ def figures_for(cfg: dict) -> list[tuple[str, str, str]]:
             ("cost", "Run time against error",
              "The headline error of each run against its wall time: the runs toward the lower left are "
              "the cheapest for their accuracy. Dotted: the tolerance.")]
-    has_front = cfg["flow"] == "slump" or (cfg["flow"] == "user" and "front" in cfg["scene"]["reference"])
-    if has_front and cfg["flow"] == "slump":
+    if cfg["flow"] == "slump":
         figs.append(("fronts", "Front against time",
                      "x_N(t) of every run; Newtonian: against the similarity front (log axes; dotted: t_c, "
                      "where the comparison starts); yield stress: against the lubrication runout."))
+    elif cfg["flow"] == "user" and "front" in cfg["scene"]["reference"]:
+        figs.append(("fronts", "Front against time", "x_N(t) of every run against the reference front (points)."))
     return figs
 
 
@@ -376,5 +380,3 @@ def render(cfg: dict, ds: xr.Dataset, figure_dir, config_text: str) -> str:
             f"</title><style>{CSS}</style></head><body><h1>sph-surge campaign report: {cfg['flow']}</h1>{lead}"
             f"<nav><ul>{toc}</ul></nav>{sections}</body></html>")
 
-
-__all__ = ["render", "write_figures", "figures_for", "write", "fluid_of"]
