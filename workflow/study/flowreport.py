@@ -30,6 +30,12 @@ def _series_label(seq) -> str:
     return " ".join(parts + [seq["scheme"], seq["shifting"], f"Ch {seq['ch']:g}"])
 
 
+def _seconds(v) -> str:
+    """A wall time: whole seconds from 10 s, two significant digits below."""
+    v = float(v)
+    return f"{v:.0f}" if v >= 10 else f"{v:.2g}"
+
+
 def _mm(dp) -> str:
     return f"{1000 * float(dp):.4g} mm"
 
@@ -114,7 +120,7 @@ def answer(cfg: dict, ds: xr.Dataset) -> str:
         else:
             cheap = (f"the cheapest run with every error below {percent(tol)} is "
                      f"{html.escape(str(ds['case'].values[best]))} "
-                     f"({ds['wall_time_s'].values[best]:.0f} s)")
+                     f"({_seconds(ds['wall_time_s'].values[best])} s)")
         who = f"<b>{html.escape(fname)}</b>: " if fname else ""
         out.append(f"<li>{who}{'; '.join(parts)}; {cheap}.</li>")
     return "<ul>" + "".join(out) + "</ul>"
@@ -144,7 +150,7 @@ def case_table(cfg: dict, ds: xr.Dataset) -> str:
             note += ", stopped" if ds["stopped"].values[i] > 0 else ", still moving"
         if ds["reason"].values[i]:
             note += f": {html.escape(str(ds['reason'].values[i]))}"
-        cells += [f"<td class='l'>{note}</td>", f"<td>{ds['wall_time_s'].values[i]:.0f}</td>",
+        cells += [f"<td class='l'>{note}</td>", f"<td>{_seconds(ds['wall_time_s'].values[i])}</td>",
                   f"<td>{int(ds['steps'].values[i])}</td>", f"<td>{int(ds['n_particles'].values[i])}</td>"]
         cls = " class='diverged'" if status == "diverged" else ""
         rows.append(f"<tr{cls}>{''.join(cells)}</tr>")
