@@ -252,7 +252,7 @@ def _film_scene(cfg: dict, case: FlowCase) -> dict:
     n = max(1, round(s["depth"] / dp))
     h = n * dp  # a whole number of rows: the depth is the film's
     fl = fluid_of(cfg, case)
-    width = dp * max(8, round(h / dp))
+    width = dp * max(n, math.ceil(6.0 * case.ch) + 1)  # the period holds 3 kernel supports
     theta = math.radians(s["angle"])
     layers = 3 * dp * max(1, math.ceil(case.ch / 1.5))
     fl["blocks"] = [{"x": [0.0, width], "z": [0.0, h]}]
