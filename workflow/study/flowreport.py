@@ -109,8 +109,10 @@ def answer(cfg: dict, ds: xr.Dataset) -> str:
             txt = (f"{scheme}'s {fc.LABELS[head]} error at dp = {_mm(ds['dp'].values[fine])} is "
                    f"{_with_error(ds[head].values[fine], se)}")
             if head == "front_error" and "exponent" in ds and np.isfinite(ds["exponent"].values[fine]):
-                txt += (f" (exponent {ds['exponent'].values[fine]:.4f} &plusmn; "
-                        f"{2 * ds['exponent_se'].values[fine]:.2g})")
+                last = float(ds["front_final_error"].values[fine])
+                b, b_se = ds["exponent"].values[fine], ds["exponent_se"].values[fine]
+                txt += (f" (at the end {'ahead of' if last > 0 else 'behind'} the reference by {percent(abs(last))}; "
+                        f"exponent {b:.4f} &plusmn; {2 * b_se:.2g})")
             if head == "runout_error":
                 txt += " (stopped)" if ds["stopped"].values[fine] > 0 else " (not stopped by the end)"
             parts.append(txt)
@@ -130,14 +132,14 @@ def case_table(cfg: dict, ds: xr.Dataset) -> str:
     errs_all = []
     for fl in fc.fluid_dicts(cfg).values():
         errs_all += [e for e in fc.errors_of(cfg, fl or None) if e not in errs_all]
-    head = ("<tr><th class='l'>case</th><th>dp</th><th class='l'>fluid</th><th class='l'>scheme</th>"
+    head = ("<tr><th>dp</th><th class='l'>fluid</th><th class='l'>scheme</th>"
             "<th class='l'>shifting</th><th>Ch</th>"
-            + "".join(f"<th>{html.escape(fc.LABELS[e])} &plusmn; 2 se</th>" for e in errs_all)
+            + "".join(f"<th>{html.escape(fc.LABELS[e])}</th>" for e in errs_all)
             + "<th>status</th><th>wall time [s]</th><th>steps</th><th>particles</th></tr>")
     rows = []
     for i in range(ds.sizes["case"]):
         status = str(ds["status"].values[i])
-        cells = [f"<td class='l'>{html.escape(str(ds['case'].values[i]))}</td>", f"<td>{_mm(ds['dp'].values[i])}</td>",
+        cells = [f"<td title='{html.escape(str(ds['case'].values[i]))}'>{_mm(ds['dp'].values[i])}</td>",
                  f"<td class='l'>{html.escape(str(ds['fluid'].values[i]))}</td>",
                  f"<td class='l'>{html.escape(str(ds['scheme'].values[i]))}</td>",
                  f"<td class='l'>{html.escape(str(ds['shifting'].values[i]))}</td>", f"<td>{ds['ch'].values[i]:g}</td>"]
@@ -154,7 +156,7 @@ def case_table(cfg: dict, ds: xr.Dataset) -> str:
                   f"<td>{int(ds['steps'].values[i])}</td>", f"<td>{int(ds['n_particles'].values[i])}</td>"]
         cls = " class='diverged'" if status == "diverged" else ""
         rows.append(f"<tr{cls}>{''.join(cells)}</tr>")
-    return f"<table>{head}{''.join(rows)}</table>"
+    return f"<table style='white-space:nowrap'>{head}{''.join(rows)}</table>"
 
 
 def convergence_table(cfg: dict, ds: xr.Dataset) -> str:
@@ -372,8 +374,9 @@ def render(cfg: dict, ds: xr.Dataset, figure_dir, config_text: str) -> str:
     prov = {"date (UTC)": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M"), "commit": _commit(),
             "host": platform.node(), "python": platform.python_version()}
     body = [("Answer", answer(cfg, ds)), ("Reference", reference_text(cfg, ds)),
-            ("Accuracy and cost", "<p>Errors in per cent &plusmn; 2 se, the sampling error from the particle "
-             "noise of the measurement (not the discretisation error).</p>" + case_table(cfg, ds)),
+            ("Accuracy and cost", "<p>One row a run (its case id shows over its dp). Errors in "
+             "per cent &plusmn; 2 se, the sampling error from the particle noise of the measurement (not the "
+             "discretisation error).</p>" + case_table(cfg, ds)),
             ("Convergence", convergence_table(cfg, ds)), ("Stability", stability_text(ds)),
             ("Figures", "".join(figs)), ("Configuration", f"<pre>{html.escape(config_text)}</pre>"),
             ("Provenance", "<table>" + "".join(
