@@ -45,6 +45,28 @@ def test_a_bad_slump_config_names_its_key(change, match):
         validate(cfg)
 
 
+def test_a_film_of_a_yield_stress_fluid_is_refused():
+    cfg = config("film")
+    cfg["fluids"]["newtonian"] = {"density": 1000.0, "rheology": "herschel_bulkley", "yield_stress": 1.0,
+                                  "consistency": 1.0, "index": 1.0, "max_viscosity": 100.0}
+    with pytest.raises(ConfigError, match="fluids.newtonian: flow film compares with the Newtonian start-up series"):
+        validate(cfg)
+
+
+def test_the_arrested_shape_of_a_release_keeps_its_plateau_where_it_does_not_yield():
+    """Where H0^3 < 3 A tau_y / (rho g) the shape is H0 up to x_1 = L0 - rho g H0^2 / (3 tau_y)
+    and the lubrication shape beyond; where the whole release yields it is ``final_shape``."""
+    rho, g, H0, L0 = 1000.0, 9.81, 0.05, 0.2
+    tau_y = 100.0  # H0^3 = 1.25e-4 < 3 A tau_y / (rho g) = 3.06e-4: a plateau
+    x1 = L0 - rho * g * H0 ** 2 / (3 * tau_y)
+    xs = np.linspace(0.0, 0.3, 301)
+    h = slump.release_shape(xs, H0, L0, tau_y, rho, g)
+    assert np.all(h[xs <= x1 - 1e-9] == H0)
+    assert h[np.argmin(abs(xs - (x1 + 0.01)))] < H0
+    assert slump.release_shape(xs, H0, L0, 5.0, rho, g) == pytest.approx(
+        slump.final_shape(xs, slump.release_runout(H0, L0, 5.0, rho, g), 5.0, rho, g))
+
+
 def test_a_number_written_1e_3_is_read_as_a_number():
     cfg = config("film")
     cfg["grid"]["dp"] = ["2e-3"]

@@ -45,10 +45,12 @@ if FLOW == "conveyor":
     METRICS_HASH = files_hash([study.metrics.__file__, study.reference.__file__], names=False)
     METRIC_KEYS = ("reference", "metrics")
 else:
-    import study.flowcampaign, study.flows.scores, study.flows.measure
+    import pathlib
 
-    METRICS_HASH = files_hash([study.flowcampaign.__file__, study.flows.scores.__file__,
-                               study.flows.measure.__file__], names=False)
+    import study.flowcampaign, study.flowconfig, study.flows
+
+    METRICS_HASH = files_hash([study.flowcampaign.__file__, study.flowconfig.__file__]
+                              + sorted(pathlib.Path(study.flows.__file__).parent.glob("*.py")), names=False)
     METRIC_KEYS = ("scene", "fluids", "metrics")
 
 wildcard_constraints:

@@ -123,6 +123,11 @@ def _scene_keys(cfg: dict) -> None:
     if flow in ("slump", "film") and not cfg.get("fluids"):
         raise FlowConfigError(f"config key fluids: flow {flow} needs at least one fluid, e.g. "
                               "fluids: {newtonian: {density: 1383.0, viscosity: 5.6}}")
+    if flow == "film":
+        for name, fl in cfg["fluids"].items():
+            if fl.get("rheology", "newtonian") != "newtonian" or "viscosity" not in fl:
+                raise FlowConfigError(f"config key fluids.{name}: flow film compares with the Newtonian start-up "
+                                      "series; give a Newtonian fluid (density, viscosity)")
     if flow == "user" and cfg.get("fluids"):
         raise FlowConfigError("config key fluids: flow user takes its fluid from its scene file (scene.file)")
 
@@ -164,7 +169,7 @@ def validate(config: dict) -> dict:
 
 
 def cases(cfg: dict) -> list[FlowCase]:
-    """dp x Ch x shifting x scheme (x fluid for slump and film), finest dp last."""
+    """fluid x scheme x shifting x Ch x dp (each in the config's order), one case each."""
     g = cfg["grid"]
     fluids = list(cfg.get("fluids") or {}) or [None]
     return [FlowCase(float(dp), float(ch), sh, scheme, fl)

@@ -51,7 +51,8 @@ def reference_text(cfg: dict, ds: xr.Dataset) -> str:
         for name, fl in (cfg.get("fluids") or {}).items():
             if fc.newtonian(fl):
                 f = cfg["metrics"]["memory_fraction"]
-                t_c = float(np.nanmax(ds["compare_from"].values)) if "compare_from" in ds else math.nan
+                mine = ds["fluid"].values == name
+                t_c = float(np.nanmax(ds["compare_from"].values[mine])) if "compare_from" in ds else math.nan
                 lines.append(
                     f"<li><b>{html.escape(name)}</b> (nu = {fl['viscosity'] / fl['density']:.4g} m2/s): "
                     "Huppert's similarity solution (J. Fluid Mech. 121, 1982), x_N = 1.411 (g A^3 t / (3 nu))^(1/5) "
@@ -73,9 +74,10 @@ def reference_text(cfg: dict, ds: xr.Dataset) -> str:
                     "creeps at about tau_y h / mu_max); the runout is the front then.</li>")
         return "".join(lines) + "</ul>"
     if flow == "film":
-        fl = next(iter(cfg["fluids"].values()))
-        return (f"<p>Film depth {1000 * s['depth']:.4g} mm on a plane inclined at {s['angle']:g} deg, "
-                f"nu = {fl['viscosity'] / fl['density']:.4g} m2/s, at rest at t = 0, periodic along the plane. "
+        nus = ", ".join(f"{html.escape(n)} nu = {f['viscosity'] / f['density']:.4g} m2/s"
+                        for n, f in cfg["fluids"].items())
+        return (f"<p>Film depth {1000 * s['depth']:.4g} mm on a plane inclined at {s['angle']:g} deg ({nus}), "
+                "at rest at t = 0, periodic along the plane. "
                 "Reference: the exact start-up series of u_t = nu u_zz + g sin(theta) with no slip at the bed "
                 "and no stress at the surface. Error: at every snapshot after t = 0 the RMS over the fluid "
                 "particles of (u - u_exact) / u_max; the largest over the snapshots is reported.</p>")
@@ -303,7 +305,8 @@ def fig_fronts(cfg: dict, ds: xr.Dataset):
             ax.plot(t, 1000 * slump.front_position(t, s["height"] * s["length"], fl["viscosity"] / fl["density"], fc.G),
                     "k--", lw=1.5, label="similarity (Huppert 1982)")
             if "compare_from" in ds:
-                ax.axvline(float(np.nanmax(ds["compare_from"].values)), color="0.5", ls=":", lw=1)
+                mine = ds["fluid"].values == name
+                ax.axvline(float(np.nanmax(ds["compare_from"].values[mine])), color="0.5", ls=":", lw=1)
             _plain_log(ax)
             ax.set_xlim(left=max(0.1, float(t.min())))
         elif cfg["flow"] == "slump":

@@ -1,7 +1,7 @@
 """A flow run's errors against its reference, each with its sampling error (docs/flows.md).
 
 Every error is an RMS over samples (times of a front, abscissas of a profile) of a deviation
-d_i. Its sampling error comes from the scatter of d_i about a least-squares line through
+d_i. Its sampling error comes from the scatter of d_i^2 about a least-squares line through
 them, with their lag-1 correlation (solver.steady.line_fits): se(mean d^2) / (2 RMS). It is
 the particle noise of the measurement, not the discretisation error.
 """
@@ -45,10 +45,10 @@ def _front_scores(t, x, t_ref, x_ref, prefix="front"):
 
 def slump_newtonian(ds, H0: float, L0: float, nu: float, memory_fraction: float) -> dict:
     """Front error against the similarity front over t >= t_c, t_c = ``slump.exponent_time``
-    (memory_fraction) (the release's memory has faded); the fitted exponent over the same
-    times; the depth profile of the last snapshot (``measure.depth_profile``, interpolated onto
-    them) against the similarity profile at 40 abscissas x <= 0.95 x_N (RMS over the reference's
-    depth at the plane)."""
+    (memory_fraction) (the release's memory has faded), and the fitted exponent over the same
+    times (both NaN where fewer than 3 snapshots reach t_c); the depth profile of the last
+    snapshot (``measure.depth_profile``, interpolated onto them) against the similarity profile
+    at 40 abscissas x <= 0.95 x_N (RMS over the reference's depth at the plane)."""
     A = H0 * L0
     t_c = slump.exponent_time(L0, A, nu, G, memory_fraction)
     xf = measure.front(ds, symmetric=True)
@@ -56,15 +56,14 @@ def slump_newtonian(ds, H0: float, L0: float, nu: float, memory_fraction: float)
     late = t >= t_c
     out = {"compare_from": t_c, "front_final": float(x[-1]),
            "front_reference_final": float(slump.front_position(t[-1], A, nu, G))}
-    if late.sum() < 3:
-        return out | {"front_error": math.nan, "front_error_se": math.nan, "front_final_error": math.nan,
-                      "exponent": math.nan, "exponent_se": math.nan, "exponent_error": math.nan,
-                      "exponent_error_se": math.nan,
-                      "depth_error": math.nan, "depth_error_se": math.nan}
-    out |= _front_scores(t, x, t[late], slump.front_position(t[late], A, nu, G))
-    b, b_se = slump.fit_front_exponent(t, x, (t_c, math.inf))
-    out |= {"exponent": b, "exponent_se": b_se, "exponent_error": b / slump.SIMILARITY_EXPONENT - 1.0,
-            "exponent_error_se": b_se / slump.SIMILARITY_EXPONENT}
+    if late.sum() >= 3:
+        out |= _front_scores(t, x, t[late], slump.front_position(t[late], A, nu, G))
+        b, b_se = slump.fit_front_exponent(t, x, (t_c, math.inf))
+        out |= {"exponent": b, "exponent_se": b_se, "exponent_error": b / slump.SIMILARITY_EXPONENT - 1.0,
+                "exponent_error_se": b_se / slump.SIMILARITY_EXPONENT}
+    else:  # the run ends before the release has forgotten its start: nothing to compare
+        out |= {k: math.nan for k in ("front_error", "front_error_se", "front_final_error", "exponent",
+                                       "exponent_se", "exponent_error", "exponent_error_se")}
     k = ds.sizes["snapshot"] - 1
     xn = float(slump.front_position(t[k], A, nu, G))
     xs = np.linspace(0.0, 0.95 * xn, 40)
@@ -95,7 +94,7 @@ def stop_time(t, x, stop_speed: float, window: float) -> float:
 def slump_yield(ds, H0: float, L0: float, tau_y: float, rho: float, stop_speed: float, window: float) -> dict:
     """Whether the front stops (``stop_time``), its runout where it stops against the
     lubrication runout (``slump.release_runout``), and the last snapshot's depth against the
-    arrested shape through that runout (RMS over 40 abscissas x <= 0.95 x_N, over its depth at
+    arrested shape of the release (``slump.release_shape``) (RMS over 40 abscissas x <= 0.95 x_N, over its depth at
     the wall). The runout's se: the front's scatter over the stop window."""
     xf = measure.front(ds, symmetric=True)
     t, x = xf["t"].values, xf.values
@@ -114,7 +113,7 @@ def slump_yield(ds, H0: float, L0: float, tau_y: float, rho: float, stop_speed: 
         out |= {"runout": math.nan, "runout_error": math.nan, "runout_error_se": math.nan}
     k = ds.sizes["snapshot"] - 1
     xs = np.linspace(0.0, 0.95 * x_lub, 40)
-    h_ref = slump.final_shape(xs, x_lub, tau_y, rho, G)
+    h_ref = slump.release_shape(xs, H0, L0, tau_y, rho, G)
     h_run = user.on_reference(xs, *measure.depth_profile(ds, k, symmetric=True))
     err, se = rms_with_se(xs, (h_run - h_ref) / h_ref[0])
     return out | {"shape_error": err, "shape_error_se": se}

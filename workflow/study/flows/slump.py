@@ -149,6 +149,14 @@ def release_runout(H0: float, L0: float, tau_y: float, rho: float, g: float) -> 
     return L0 + rho * g * H0 * H0 / (6.0 * tau_y)
 
 
+def release_shape(x, H0: float, L0: float, tau_y: float, rho: float, g: float):
+    """Arrested depth of a rectangular release in the lubrication limit: ``final_shape`` through
+    ``release_runout``, capped at H0 (the plateau that stays at the wall when the release does
+    not yield there; where it does, the shape is below H0 everywhere and the cap does nothing)."""
+    x_N = release_runout(H0, L0, tau_y, rho, g)
+    return np.minimum(final_shape(x, x_N, tau_y, rho, g), H0)
+
+
 def runout_ratio(H0: float, L0: float, tau_y: float, rho: float, g: float) -> float:
     """x_N / H0: the arrested front's distance from the end wall (``release_runout``) over the
     release height."""
