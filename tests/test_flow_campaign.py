@@ -37,6 +37,7 @@ def test_an_unknown_flow_is_refused_with_the_allowed_ones():
     (lambda c: c.pop("fluids"), r"config key fluids: flow slump needs at least one fluid"),
     (lambda c: c["grid"].update(scheme=["dualsphysics"]), r"grid.scheme.0: 'dualsphysics' is not one of"),
     (lambda c: c["fluids"]["newtonian"].update(viscosity=-1.0), r"config key fluids.newtonian: .*viscosity"),
+    (lambda c: c["fluids"]["bingham"].pop("yield_stress"), r"fluids.bingham.yield_stress: a yield-stress slump needs"),
 ])
 def test_a_bad_slump_config_names_its_key(change, match):
     cfg = config("slump")

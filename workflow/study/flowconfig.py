@@ -123,6 +123,12 @@ def _scene_keys(cfg: dict) -> None:
     if flow in ("slump", "film") and not cfg.get("fluids"):
         raise FlowConfigError(f"config key fluids: flow {flow} needs at least one fluid, e.g. "
                               "fluids: {newtonian: {density: 1383.0, viscosity: 5.6}}")
+    if flow == "slump":
+        for name, fl in cfg["fluids"].items():
+            if fl.get("rheology", "newtonian") != "newtonian" and not _positive(fl.get("yield_stress")):
+                raise FlowConfigError(f"config key fluids.{name}.yield_stress: a yield-stress slump needs "
+                                      "tau_y > 0 (its reference is the arrested shape); a Newtonian fluid "
+                                      "takes viscosity instead")
     if flow == "film":
         for name, fl in cfg["fluids"].items():
             if fl.get("rheology", "newtonian") != "newtonian" or "viscosity" not in fl:
