@@ -217,3 +217,28 @@ def test_a_film_campaign_runs_end_to_end_and_reports_its_answer(tmp_path):
         assert section in html
     assert "Verdict" not in html and "Where the plug is" not in html
     assert "newtonian</b>: surge's velocity profile error at dp = 2.5 mm is" in html
+
+
+def test_a_diverged_run_is_recorded_with_its_reason_and_no_errors(tmp_path):
+    """A flow run that diverged is scored with no errors; the campaign dataset, the figures and the
+    report still come out, the report's stability map naming its reason."""
+    from solver.output import write_atomic
+    from study.flowcampaign import reduce, score
+    from study.flowreport import render, write_figures
+    cfg = config("film")
+    cfg["grid"].update(dp=[2e-3, 1e-3], scheme=["surge"])
+    cfg = validate(cfg)
+    h, nu, theta = 0.02, 5.6 / 1383.0, math.radians(15.3)
+    z = np.arange(0.5e-3, h, 1e-3)
+    good = fake_run([0.0, 0.1], [(z * 0, z, film.velocity(z, t, h, nu, G, theta)) for t in (0.0, 0.1)], 1e-3)
+    bad = fake_run([0.0], [(z * 0, z, z * 0)], 2e-3)
+    bad.attrs.update(status="diverged", reason="density deviation 0.2 exceeds 0.1")
+    for c, run in zip(cases(cfg), (bad, good)):
+        run.attrs.update(wall_time_s=1.0, steps=10, n_particles=z.size)
+        write_atomic(score(cfg, c, run), tmp_path / c.id / "metrics.nc")
+    ds = reduce(cfg, tmp_path)
+    assert list(ds["status"].values) == ["diverged", "completed"]
+    assert np.isnan(ds["profile_error"].values[0]) and ds["profile_error"].values[1] < 1e-9
+    write_figures(cfg, ds, tmp_path / "figures")
+    html = render(cfg, ds, tmp_path / "figures", "")
+    assert "1 of 2 runs did not complete" in html and "diverged: density deviation 0.2 exceeds 0.1" in html
