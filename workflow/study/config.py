@@ -81,6 +81,23 @@ def _message(err) -> str:
     return err.message
 
 
+def with_defaults(config: dict, schema: dict):
+    """(a copy of ``config`` with its scalars read as the schema types them and the schema's
+    defaults filled in, the schema's errors sorted by key path)."""
+    import jsonschema
+    cfg = coerce_scalars(copy.deepcopy(config), schema)
+    validator_cls = jsonschema.validators.validator_for(schema)
+
+    def set_defaults(validator, properties, instance, schema):  # fill defaults while validating
+        for name, sub in properties.items():
+            if isinstance(instance, dict) and "default" in sub and name not in instance:
+                instance[name] = copy.deepcopy(sub["default"])
+        yield from validator_cls.VALIDATORS["properties"](validator, properties, instance, schema)
+
+    Defaulting = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
+    return cfg, sorted(Defaulting(schema).iter_errors(cfg), key=lambda e: list(e.absolute_path))
+
+
 def validate(config: dict) -> dict:
     """Validate against the JSON schema (filling defaults) and check what a schema cannot.
 
@@ -97,19 +114,7 @@ def validate(config: dict) -> dict:
             return flowconfig.validate(config)
         except FlowConfigError as exc:
             raise ConfigError(str(exc)) from None
-    import jsonschema
-    schema = load_schema()
-    cfg = coerce_scalars(copy.deepcopy(config), schema)
-    validator_cls = jsonschema.validators.validator_for(schema)
-
-    def set_defaults(validator, properties, instance, schema):  # fill defaults while validating
-        for name, sub in properties.items():
-            if isinstance(instance, dict) and "default" in sub and name not in instance:
-                instance[name] = copy.deepcopy(sub["default"])
-        yield from validator_cls.VALIDATORS["properties"](validator, properties, instance, schema)
-
-    Defaulting = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
-    errors = sorted(Defaulting(schema).iter_errors(cfg), key=lambda e: list(e.absolute_path))
+    cfg, errors = with_defaults(config, load_schema())
     if errors:  # every problem at once, each naming its key
         raise ConfigError("; ".join(f"config key {_path(e)}: {_message(e)}" for e in errors))
     try:

@@ -43,6 +43,14 @@ def errors_of(cfg: dict, fluid: dict | None = None) -> tuple[str, ...]:
     return ERRORS[(flow, True if fluid is None else newtonian(fluid))]
 
 
+def all_errors(cfg: dict) -> list[str]:
+    """The error names of every fluid of the campaign, each once, in order."""
+    out: list[str] = []
+    for fl in fluid_dicts(cfg).values():
+        out += [e for e in errors_of(cfg, fl or None) if e not in out]
+    return out
+
+
 def case_by_id(cfg: dict, case_id: str) -> FlowCase:
     for c in cases(cfg):
         if c.id == case_id:

@@ -73,21 +73,10 @@ class FlowCase:
 
 
 def _schema_errors(cfg: dict) -> dict:
-    import jsonschema
-    from .config import coerce_scalars
+    """The config with the flow schema's defaults; FlowConfigError listing every schema error."""
+    from .config import with_defaults
     with open(SCHEMA) as fh:
-        schema = yaml.safe_load(fh)
-    cfg = coerce_scalars(copy.deepcopy(cfg), schema)
-    validator_cls = jsonschema.validators.validator_for(schema)
-
-    def set_defaults(validator, properties, instance, sub):
-        for name, s in properties.items():
-            if isinstance(instance, dict) and "default" in s and name not in instance:
-                instance[name] = copy.deepcopy(s["default"])
-        yield from validator_cls.VALIDATORS["properties"](validator, properties, instance, sub)
-
-    Defaulting = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
-    errors = sorted(Defaulting(schema).iter_errors(cfg), key=lambda e: list(e.absolute_path))
+        cfg, errors = with_defaults(cfg, yaml.safe_load(fh))
     if errors:
         raise FlowConfigError("; ".join(
             f"config key {'.'.join(str(x) for x in e.absolute_path) or '(top level)'}: {e.message}" for e in errors))

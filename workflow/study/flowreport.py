@@ -3,7 +3,6 @@ convergence, stability, the figures, the configuration and provenance. The paper
 are the conveyor's and are not judged here."""
 from __future__ import annotations
 
-import base64
 import html
 import math
 from pathlib import Path
@@ -18,7 +17,7 @@ import xarray as xr  # noqa: E402
 from . import flowcampaign as fc  # noqa: E402
 from .flowconfig import read_references, reference_runout  # noqa: E402
 from .numbers import percent  # noqa: E402
-from .report import CSS, _commit, _with_error  # noqa: E402
+from .report import _commit, _with_error, figure_html, page  # noqa: E402
 
 FLOW_TITLES = {"slump": "a viscous gravity current from a rectangular release (slump)",
                "film": "the start-up from rest of a film on an incline",
@@ -131,9 +130,7 @@ def answer(cfg: dict, ds: xr.Dataset) -> str:
 
 
 def case_table(cfg: dict, ds: xr.Dataset) -> str:
-    errs_all = []
-    for fl in fc.fluid_dicts(cfg).values():
-        errs_all += [e for e in fc.errors_of(cfg, fl or None) if e not in errs_all]
+    errs_all = fc.all_errors(cfg)
     head = ("<tr><th>dp</th><th class='l'>fluid</th><th class='l'>scheme</th>"
             "<th class='l'>shifting</th><th>Ch</th>"
             + "".join(f"<th>{html.escape(fc.LABELS[e])}</th>" for e in errs_all)
@@ -238,10 +235,7 @@ def _plain_log(ax):
 
 
 def fig_errors(cfg: dict, ds: xr.Dataset):
-    fluids = fc.fluid_dicts(cfg)
-    errs = []
-    for fl in fluids.values():
-        errs += [e for e in fc.errors_of(cfg, fl or None) if e not in errs]
+    errs = fc.all_errors(cfg)
     from .figures import _log_axes
     fig, axes = plt.subplots(1, len(errs), figsize=(4.2 * len(errs), 3.6), squeeze=False)
     for ax, e in zip(axes[0], errs):
@@ -360,13 +354,8 @@ def render(cfg: dict, ds: xr.Dataset, figure_dir, config_text: str) -> str:
     import datetime as _dt
     import platform
     fmt = cfg["figures"]["format"]
-    figs = []
-    for name, title, caption in figures_for(cfg):
-        path = Path(figure_dir) / f"{name}.{fmt}"
-        data = base64.b64encode(path.read_bytes()).decode()
-        mime = "image/svg+xml" if fmt == "svg" else "image/png"
-        figs.append(f'<figure id="{name}"><h3>{html.escape(title)}</h3><img alt="{html.escape(title)}" '
-                    f'src="data:{mime};base64,{data}"><figcaption>{html.escape(caption)}</figcaption></figure>')
+    figs = [figure_html(Path(figure_dir) / f"{name}.{fmt}", title, caption)
+            for name, title, caption in figures_for(cfg)]
     n = ds.sizes["case"]
     wall = float(np.nansum(ds["wall_time_s"].values))
     lead = (f"<p class='lead'>Flow: {FLOW_TITLES[cfg['flow']]}. {n} runs, "
@@ -385,10 +374,5 @@ def render(cfg: dict, ds: xr.Dataset, figure_dir, config_text: str) -> str:
             ("Provenance", "<table>" + "".join(
                 f"<tr><th class='l'>{k}</th><td class='l'>{html.escape(str(v))}</td></tr>" for k, v in prov.items())
              + "</table>")]
-    toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
-    sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
-                       for t, c in body)
-    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>sph-surge {cfg['flow']} campaign"
-            f"</title><style>{CSS}</style></head><body><h1>sph-surge campaign report: {cfg['flow']}</h1>{lead}"
-            f"<nav><ul>{toc}</ul></nav>{sections}</body></html>")
+    return page(f"sph-surge {cfg['flow']} campaign", f"sph-surge campaign report: {cfg['flow']}", lead, body)
 

@@ -390,13 +390,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "second: where zeta_f reads more than it, the toe wandered or particles joined or left the "
                "tip while the front itself held.</p>"
                + ensemble_paragraph(ds))
-    figs = []
-    for path, title, caption in figures:
-        data = base64.b64encode(Path(path).read_bytes()).decode()
-        mime = "image/svg+xml" if str(path).endswith(".svg") else "image/png"
-        figs.append(f'<figure id="{html.escape(Path(path).stem)}"><h3>{html.escape(title)}</h3>'
-                    f'<img alt="{html.escape(title)}" src="data:{mime};base64,{data}">'
-                    f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+    figs = [figure_html(path, title, caption) for path, title, caption in figures]
     import matplotlib
     import snakemake
     import solver
@@ -428,12 +422,27 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
         f" ({int(np.sum(ds['realisations'].values > 0))} grid points; {ensemble_counts(ds)})")
     lead = (f"<p class='lead'>{n} cases{ensemble}, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
             f"{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
+    return page("sph-surge campaign report", "sph-surge campaign report", lead, body)
+
+
+def figure_html(path, title: str, caption: str) -> str:
+    """A figure embedded in the page (base64), with its title and caption."""
+    data = base64.b64encode(Path(path).read_bytes()).decode()
+    mime = "image/svg+xml" if str(path).endswith(".svg") else "image/png"
+    return (f'<figure id="{html.escape(Path(path).stem)}"><h3>{html.escape(title)}</h3>'
+            f'<img alt="{html.escape(title)}" src="data:{mime};base64,{data}">'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def page(title: str, heading: str, lead: str, body: list[tuple[str, str]]) -> str:
+    """The self-contained HTML page: heading, lead, a table of contents, then each (title, html)
+    section."""
     toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
     sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
                        for t, c in body)
     return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
-            f"<title>sph-surge campaign report</title><style>{CSS}</style></head><body>"
-            f"<h1>sph-surge campaign report</h1>{lead}<nav><ul>{toc}</ul></nav>{sections}</body></html>")
+            f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>"
+            f"<h1>{html.escape(heading)}</h1>{lead}<nav><ul>{toc}</ul></nav>{sections}</body></html>")
 
 
 def write(text: str, path) -> None:
