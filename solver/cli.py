@@ -26,6 +26,8 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--checkpoint", default=None,
                    help="checkpoint file (default: OUTPUT.ckpt); resumed from when it matches")
     f.add_argument("--no-checkpoint", action="store_true", help="never write or read a checkpoint")
+    f.add_argument("--progress", default=None, metavar="JSON",
+                   help="write the run's progress there every few seconds (python -m study status reads it)")
     f.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a case key, e.g. --set dp=0.002 --set steady.max_time=5")
     f.add_argument("--allow-diverged", action="store_true",
@@ -146,7 +148,7 @@ def _front(args) -> int:
     from .front import run_front
     from .output import write_atomic
     ckpt = None if args.no_checkpoint else (args.checkpoint or args.output + ".ckpt")
-    ds = run_front(case, quiet=args.quiet, checkpoint=ckpt)
+    ds = run_front(case, quiet=args.quiet, checkpoint=ckpt, progress=args.progress)
     write_atomic(ds, args.output)
     if ckpt is not None and os.path.exists(ckpt):  # only once the result is on disk
         os.remove(ckpt)

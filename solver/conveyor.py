@@ -51,6 +51,7 @@ class Steady:
     max_time: float = 30.0  # s: give up (status not_steady) after this
     min_time: float = 0.0  # s after the end of the belt ramp before the averaging window may start
     stop: bool = True  # false: run to max_time; the window pair is the final 2W (fixed end time)
+    context: float = 15.0  # s of samples before each window (from min_time on) that its se reads
 
 
 @dataclass
@@ -154,7 +155,8 @@ class ConveyorCase(YamlData):
 
     def criteria(self) -> SteadyCriteria:
         s = self.steady
-        return SteadyCriteria(window=s.average, fraction=s.fraction, min_time=self.ramp_end + s.min_time)
+        return SteadyCriteria(window=s.average, fraction=s.fraction, min_time=self.ramp_end + s.min_time,
+                              context=s.context)
 
 
 # flat numerics keys of an older case layout: where each lives now
@@ -280,6 +282,8 @@ def validate_case(c: ConveyorCase) -> None:
         positive(getattr(s, key), f"case.steady.{key}")
     if s.min_time < 0:
         raise SceneError("case.steady.min_time: must be >= 0")
+    if not s.context >= 0.0:
+        raise SceneError(f"case.steady.context: {s.context!r} must be >= 0 (s)")
     if not 0.0 <= s.fraction < 0.1:
         raise SceneError(f"case.steady.fraction: {s.fraction!r} is not in [0, 0.1)")
     if s.average < 10 * p.interval:

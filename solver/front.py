@@ -20,6 +20,7 @@ from .build import build_particles
 from .conveyor import ConveyorCase, build_scene, lubrication_velocity, scheme_fluid, start_offsets
 from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, last_crossing, toe_position
+from .progress import ProgressFile, chain
 from .run import Runner
 from .simulation import Simulation
 from .sources import source_hash
@@ -223,7 +224,8 @@ class FrontMonitor:
                     f"area by {100 * drift:+.1f} % (max_area_drift = {self.case.max_area_drift:g})")
         if self.state != "steady":
             w = self.detector.crit.window
-            start = -math.inf if math.isnan(self.detector.t_first) else sim.t - 2.0 * w - self.interval
+            span = 2.0 * w + self.detector.crit.context + self.interval
+            start = -math.inf if math.isnan(self.detector.t_first) else sim.t - span
             self.state = "steady" if self.detector.update(self.record(start)) else "transient"
             if self.state == "steady" and self.case.steady.stop:
                 return ("completed", "")
@@ -320,6 +322,8 @@ class FrontMonitor:
         ds.attrs["window_start_s"], ds.attrs["window_end_s"] = float(a0), float(a1)
         ds.attrs["holdout_start_s"], ds.attrs["holdout_end_s"] = float(b0), float(b1)
         ds.attrs["steady_judgement"] = j.describe() if j is not None else "record shorter than two windows"
+        ds.attrs["steady_min_time_s"] = float(self.detector.crit.min_time)
+        ds.attrs["se_context_s"] = float(self.detector.crit.context)
         for q, r in (j.ratios.items() if j is not None else ()):
             ds.attrs[f"drift_ratio_{q.replace(' ', '_')}"] = float(r)
         if t.size >= 2:
@@ -418,12 +422,13 @@ def start_flux_ratio(case: ConveyorCase, warm_state, quiet: bool = True) -> tupl
     return film.flux_ratio, film.describe()
 
 
-def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dataset:
+def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None, progress=None) -> xr.Dataset:
     """Run the case to steady state (or max_time) and return its dataset.
 
     With ``checkpoint`` (a path), the run resumes from a matching checkpoint there and
     writes one every ``case.checkpoint_interval`` seconds of simulated time; the caller
-    removes it once the result is safely written.
+    removes it once the result is safely written. With ``progress`` (a path), the run's
+    progress is written there every few wall seconds (solver/progress.py).
     """
     warm_note = ""
     state = None
@@ -468,7 +473,10 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None) -> xr.Dat
         if resumed:
             ckpt.restore(runner, saved)
         monitor = runner.monitors[0]
-    res = runner.run(quiet=quiet, on_step=ckpt)
+    report = ProgressFile(progress, case.name, monitor, case.steady.max_time) if progress else None
+    res = runner.run(quiet=quiet, on_step=chain(ckpt, report))
+    if report is not None:
+        report.write(runner, res.status)
     front_ds = monitor.dataset()
     if res.status == "completed" and not front_ds.attrs["steady"]:
         res.status = "not_steady"
@@ -533,6 +541,7 @@ def replay(ds: xr.Dataset, case: ConveyorCase | None = None, crit: steady.Steady
     det = steady.SteadyDetector(crit or case.criteria())
     w = det.crit.window
     for k in range(rec.t.size):
-        if det.update(rec.span(rec.t[k] - 2.0 * w - case.probes.interval if k else -math.inf, rec.t[k])):
+        span = 2.0 * w + det.crit.context + case.probes.interval
+        if det.update(rec.span(rec.t[k] - span if k else -math.inf, rec.t[k])):
             break
     return det.found

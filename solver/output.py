@@ -4,6 +4,7 @@ from __future__ import annotations
 import os
 import platform
 import tempfile
+import time
 
 import numba
 import numpy as np
@@ -67,6 +68,8 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         "reason": res.reason,
         "steps": res.steps,
         "wall_time_s": res.wall_time,
+        "started_unix": res.started_unix,
+        "ended_unix": time.time(),
         "threads": res.threads,
         "n_particles": res.n_particles,
         "dp": sc.dp, "h": sc.h, "c0": sc.c0, "rho0": sc.fluid.density,

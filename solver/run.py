@@ -28,6 +28,7 @@ class RunResult:
     n_particles: int = 0
     cg_iterations: int = 0  # of the implicit viscous solves, over the steps this process ran
     rkc_stages: int = 0  # of the sub-stepped viscous updates, over the steps this process ran
+    started_unix: float = field(default_factory=_time.time)  # when the run first started (kept on resume)
     diag_time: list = field(default_factory=list)
     diag: dict = field(default_factory=lambda: {k: [] for k in DIAGNOSTICS})
     snap_time: list = field(default_factory=list)

@@ -10,8 +10,9 @@ Quantities, each a set of components sampled every probe interval:
 
 A window pair is an averaging window A = [t - 2W, t - W] and a hold-out window B = (t - W, t].
 Over each window every component y_i gets a least-squares line: mean m_i with standard error
-s_i, slope b_i with standard error sb_i (residual variance, widened for the residuals' lag-1
-correlation; ``_line_fits``). Each component's two drifts, over its allowance:
+s_i, slope b_i with standard error sb_i, both from the series' autocorrelation over the
+``context`` s before the window (solver.timeseries.window_fits: samples from min_time on; the
+window's own only where fewer than a window's samples precede it). Each component's two drifts, over its allowance:
 
   hold-out change  d_i = (m_B,i - m_A,i) / max(Z sqrt(s_A,i^2 + s_B,i^2), f |m_A,i|)
   fitted change    e_i = b_A,i W / max(Z sb_A,i W, f |m_A,i|)
@@ -21,18 +22,20 @@ the components measured in both windows (none: the quantity fails); the pair is 
 every R is at most 1. The toe's fitted change is its mean velocity over A times W: with a fixed
 volume of fluid, a front that
 creeps by a fraction of the layer's length thins the layer by that fraction, which the same
-fraction of the depth bounds. The first probe time t >= min_time + 2W at which a pair is steady
-ends the run; its A is the averaging window and its B the hold-out.
+fraction of the depth bounds. A pair is judged every JUDGE_EVERY s from min_time + 2W on; the
+first that is steady ends the run; its A is the averaging window and its B the hold-out.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
 
-import numba as nb
 import numpy as np
 
+from .timeseries import window_fits
+
 Z = 2.0  # standard errors a drift may reach before it counts as real
+JUDGE_EVERY = 0.1  # s of simulated time between the pairs judged (each reads up to 2W + context of samples)
 
 
 @dataclass
@@ -40,6 +43,7 @@ class SteadyCriteria:
     window: float = 3.0  # W [s]: the averaging window and the hold-out window, each
     fraction: float = 5.0e-4  # f: a drift below f times the quantity's value passes however small its se
     min_time: float = 0.0  # s: earliest start of the averaging window
+    context: float = 15.0  # s of samples before each window (never before min_time) in its se
 
 
 @dataclass
@@ -92,74 +96,11 @@ class Judgement:
         return f"{span}: drift / allowance " + ", ".join(bad) if bad else f"{span}: steady"
 
 
-def line_fits(t, ys) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def line_fits(t, ys, lead: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(mean, se of the mean, slope, se of the slope) of each row of ys (times t) over its
-    finite samples (module docstring); NaN with fewer than 3, se 0 where the residuals are 0."""
-    t = np.ascontiguousarray(t, dtype=float)
-    ys = np.ascontiguousarray(np.atleast_2d(np.asarray(ys, dtype=float)))
-    return _line_fits(t, ys)
-
-
-@nb.njit(cache=True)
-def _line_fits(t, ys):
-    """Per row: the least-squares line over its finite samples (t_i, y_i), residuals e_i,
-    ss = sum e_i^2; the lag-1 correlation r1 = sum e_i e_(i+1) / ss (at least 0) plus its
-    estimation bias (1 + 3 r1) / n, at most 0.95; n_eff = max(n (1 - r1) / (1 + r1), 3);
-    var = ss / (n - 2) * n_eff / max(n_eff - 2, 1) (the variance a line through correlated
-    samples hides); se(mean) = sqrt(var / n_eff), se(slope) = sqrt(var / stt * n / n_eff)."""
-    rows = ys.shape[0]
-    mean = np.full(rows, np.nan)
-    se_mean = np.full(rows, np.nan)
-    slope = np.full(rows, np.nan)
-    se_slope = np.full(rows, np.nan)
-    tt = np.empty(t.size)
-    yy = np.empty(t.size)
-    for r in range(rows):
-        n = 0
-        for i in range(t.size):
-            if np.isfinite(ys[r, i]):
-                tt[n] = t[i]
-                yy[n] = ys[r, i]
-                n += 1
-        if n < 3:
-            continue
-        tm = 0.0
-        ym = 0.0
-        for i in range(n):
-            tm += tt[i]
-            ym += yy[i]
-        tm /= n
-        ym /= n
-        stt = 0.0
-        sty = 0.0
-        for i in range(n):
-            stt += (tt[i] - tm) ** 2
-            sty += (tt[i] - tm) * (yy[i] - ym)
-        if stt <= 0.0:
-            continue
-        b = sty / stt
-        mean[r] = ym
-        slope[r] = b
-        ss = 0.0
-        s1 = 0.0
-        prev = 0.0
-        for i in range(n):
-            e = yy[i] - ym - b * (tt[i] - tm)
-            ss += e * e
-            if i > 0:
-                s1 += e * prev
-            prev = e
-        if ss == 0.0:
-            se_mean[r] = 0.0
-            se_slope[r] = 0.0
-            continue
-        r1 = max(s1 / ss, 0.0)
-        r1 = min(r1 + (1.0 + 3.0 * r1) / n, 0.95)
-        n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
-        var = ss / (n - 2) * n_eff / max(n_eff - 2.0, 1.0)
-        se_mean[r] = math.sqrt(var / n_eff)
-        se_slope[r] = math.sqrt(var / stt * (n / n_eff))
-    return mean, se_mean, slope, se_slope
+    finite samples from index ``lead`` on, the ``lead`` samples before them the context of
+    their standard errors (solver.timeseries.window_fits)."""
+    return window_fits(t, ys, lead)
 
 
 def trend_bound(t, y) -> tuple[float, float]:
@@ -176,19 +117,25 @@ def trend(t, y) -> float:
 FRONT_VELOCITY_SPAN = 1.0  # s: zeta_f's toe velocity is averaged over one second (docs/scheme.md section 4)
 
 
-def front_velocity_fit(t, toe) -> tuple[float, float]:
-    """(toe slope, its standard error) over the last FRONT_VELOCITY_SPAN of the samples
-    (``trend_bound``): the front velocity of zeta_f and its sampling error."""
+def front_velocity_fit(t, toe, context: float = 0.0) -> tuple[float, float]:
+    """(toe slope, its standard error) over the last FRONT_VELOCITY_SPAN of the samples, the
+    ``context`` s of samples before that second joining the se (``line_fits``): the front
+    velocity of zeta_f and its sampling error."""
     t = np.asarray(t, dtype=float)
-    last = t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9
-    return trend_bound(t[last], np.asarray(toe, dtype=float)[last])
+    t0 = t[-1] - FRONT_VELOCITY_SPAN - 1e-9
+    use = t >= t0 - context
+    lead = int((use & (t < t0)).sum())
+    _, _, b, sb = line_fits(t[use], np.asarray(toe, dtype=float)[use][None, :], lead)
+    return float(b[0]), float(sb[0])
 
 
-def _drift_ratios(ta, ya, tb, yb, window: float, fraction: float) -> tuple[float, float]:
-    """(R_D, R_F) of a quantity whose components are the columns of ya (times ta, window A) and
-    yb (window B), over the components measured in both windows (module docstring)."""
-    ma, sa, ba, sba = line_fits(ta, ya.T)
-    mb, sb, _, _ = line_fits(tb, yb.T)
+def _drift_ratios(t, y, a, b, lead_a, lead_b, window: float, fraction: float) -> tuple[float, float]:
+    """(R_D, R_F) of a quantity whose components are the columns of y (times t): window A is the
+    samples a, its context lead_a and a; B is b, its context lead_b and b (module docstring),
+    over the components measured in both windows."""
+    ia, ib = np.concatenate([lead_a, a]), np.concatenate([lead_b, b])
+    ma, sa, ba, sba = line_fits(t[ia], y[ia].T, lead_a.size)
+    mb, sb, _, _ = line_fits(t[ib], y[ib].T, lead_b.size)
     ok = np.isfinite(ma) & np.isfinite(mb) & np.isfinite(sa) & np.isfinite(sb) & np.isfinite(ba)
     if not ok.any():
         return math.nan, math.nan
@@ -203,30 +150,34 @@ def _drift_ratios(ta, ya, tb, yb, window: float, fraction: float) -> tuple[float
 
 def judge(rec: Record, t_end: float, crit: SteadyCriteria) -> Judgement:
     """The window pair ending at ``t_end``: A = [t_end - 2W, t_end - W], B = (t_end - W, t_end];
-    not judged (no drifts: not steady) with fewer than 8 samples in A or 4 in B."""
-    w, f = crit.window, crit.fraction
+    each window's se also reads the ``crit.context`` s of samples before it, from min_time on.
+    Not judged (no drifts: not steady) with fewer than 8 samples in A or 4 in B."""
+    w, f, eps = crit.window, crit.fraction, 1e-9
     out = Judgement(t_end, w)
     t = rec.t
-    in_a = (t >= t_end - 2.0 * w - 1e-9) & (t <= t_end - w + 1e-9)
-    in_b = (t > t_end - w + 1e-9) & (t <= t_end + 1e-9)
-    if in_a.sum() < 8 or in_b.sum() < 4:
+    in_a = np.flatnonzero((t >= t_end - 2.0 * w - eps) & (t <= t_end - w + eps))
+    in_b = np.flatnonzero((t > t_end - w + eps) & (t <= t_end + eps))
+    if in_a.size < 8 or in_b.size < 4:
         return out
-    ta, tb = t[in_a], t[in_b]
-    out.drifts["toe"] = _drift_ratios(ta, rec.toe[in_a, None], tb, rec.toe[in_b, None], w, f)
-    out.drifts["depth"] = _drift_ratios(ta, rec.depth[in_a, None], tb, rec.depth[in_b, None], w, f)
-    out.drifts["surface"] = _drift_ratios(ta, rec.surface[in_a], tb, rec.surface[in_b], w, f)
-    for k in range(rec.stations.shape[1]):
-        out.drifts[f"station {k + 1}"] = _drift_ratios(ta, rec.stations[in_a, k], tb, rec.stations[in_b, k], w, f)
+    lo = crit.min_time - eps
+    lead_a = np.flatnonzero((t >= max(lo, t_end - 2.0 * w - crit.context - eps)) & (t < t_end - 2.0 * w - eps))
+    lead_b = np.flatnonzero((t >= max(lo, t_end - w - crit.context - eps)) & (t <= t_end - w + eps))
+    quantities = {"toe": rec.toe[:, None], "depth": rec.depth[:, None], "surface": rec.surface}
+    quantities.update({f"station {k + 1}": rec.stations[:, k] for k in range(rec.stations.shape[1])})
+    for q, y in quantities.items():
+        out.drifts[q] = _drift_ratios(t, y, in_a, in_b, lead_a, lead_b, w, f)
     return out
 
 
 class SteadyDetector:
-    """Judges the window pair ending at each probe time from max(crit.min_time, first sample)
-    + 2W on; the first steady pair is the run's (``found``)."""
+    """Judges the window pair ending at a probe time every JUDGE_EVERY s from max(crit.min_time,
+    first sample) + 2W on; the first steady pair is the run's (``found``)."""
 
     def __init__(self, crit: SteadyCriteria):
         self.crit = crit
         self.found: Judgement | None = None
+        self.last: Judgement | None = None  # the latest pair judged
+        self.next_judgement = -math.inf
         self.t_first = math.nan  # the record's first sample time
 
     @property
@@ -244,8 +195,11 @@ class SteadyDetector:
         needs to hold only the last 2W); True once a pair has been steady."""
         if rec.t.size and math.isnan(self.t_first):
             self.t_first = float(rec.t[0])
-        if self.found is None and rec.t.size and rec.t[-1] >= self.earliest_end - 1e-9:
+        due = rec.t.size and rec.t[-1] >= max(self.earliest_end, self.next_judgement) - 1e-9
+        if self.found is None and due:
+            self.next_judgement = float(rec.t[-1]) + JUDGE_EVERY
             j = judge(rec, float(rec.t[-1]), self.crit)
+            self.last = j
             if j.steady:
                 self.found = j
         return self.found is not None

@@ -14,7 +14,7 @@ import yaml
 
 from study import config as cfgmod
 from study.grid import CASE_ID, case_id, expand, fmt
-from study.metrics import JACKKNIFE_BLOCKS, case_metrics, rms_difference, zeta_f_error
+from study.metrics import case_metrics, rms_difference, zeta_f_error
 from study.reference import read_velocity_csv, theory
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -295,11 +295,9 @@ def _series_theory():
 
 
 def test_window_errors_recover_white_noise():
-    """zeta_u's jackknife se is the standard error of the window mean, sigma / sqrt(n) times
-    the RMS of u*_ref over the heights, averaged over 200 records within 10 % (the jackknife's
-    own scatter with 5 blocks is about 35 % a record). zeta_h's adds half the fitted change of
-    a depth that does not drift: sigma / sqrt(n) sqrt(3 (n - 1) / (n + 1)) |Z| for a normal Z,
-    so its mean is E sqrt(1 + 3 (n - 1) / (n + 1) Z^2) sigma / sqrt(n), within 10 %."""
+    """zeta_h's and zeta_u's se are the standard error of the window mean, sigma / sqrt(n) (times
+    the RMS of u*_ref over the heights for zeta_u): their RMS over 200 records of white noise
+    within 20 % (solver.timeseries reads a record this short as its own context: measured +15 %)."""
     n, sd_h, sd_u = 51, 0.004, 0.01
     se_h, se_u = [], []
     for seed in range(200):
@@ -307,12 +305,10 @@ def test_window_errors_recover_white_noise():
         m = case_metrics(run, ref)
         se_h.append(float(m.zeta_h_se))
         se_u.append(m.zeta_u_se.values)
-    z = np.linspace(-8.0, 8.0, 20001)
-    factor = np.trapezoid(np.sqrt(1 + 3 * (n - 1) / (n + 1) * z ** 2) * np.exp(-z * z / 2), z) / math.sqrt(2 * math.pi)
-    assert np.mean(se_h) == pytest.approx(factor * sd_h / math.sqrt(n), rel=0.10)
+    assert math.sqrt(np.mean(np.square(se_h))) == pytest.approx(sd_h / math.sqrt(n), rel=0.20)
     u = ref["velocity"].sel(station=9.7).values
     rms_u = math.sqrt(np.nanmean(u ** 2))
-    assert np.mean(se_u, axis=0)[2] == pytest.approx(sd_u / math.sqrt(n) * rms_u, rel=0.10)
+    assert math.sqrt(np.mean(np.square(se_u), axis=0)[2]) == pytest.approx(sd_u / math.sqrt(n) * rms_u, rel=0.20)
     # a noiseless record has no sampling error
     m = case_metrics(*series_run())
     assert float(m.zeta_h_se) < 1e-12 and float(m.zeta_fs_se) < 1e-12 and np.all(m.zeta_u_se.values < 1e-12)
@@ -345,14 +341,16 @@ def test_metrics_over_the_hold_out_window_and_where_they_move():
         assert [k for k, _, _ in holdout_moves(ds, 0)] == moved
 
 
-def test_window_errors_carry_the_depth_drift():
-    """A depth ramping by 1 % h_n through the window: zeta_h's se holds half the change,
-    0.5 %, with the ramp's jackknife scatter sqrt((B + 1) / 12) / B of the change on top."""
+def test_window_errors_are_the_scatter_about_the_line():
+    """A depth ramping by 1 % h_n through the window: zeta_h is the window mean's (1.02 + 0.005);
+    its se is that of the scatter about the fitted line (0 without noise, sigma / sqrt(n) within
+    20 % over 100 records with it): a drift is the steady detection's to judge, not a sampling error."""
     run, ref = series_run(depth_ramp=0.01)
     m = case_metrics(run, ref)
-    jack = 0.01 * math.sqrt((JACKKNIFE_BLOCKS + 1) / 12) / JACKKNIFE_BLOCKS
-    assert float(m.zeta_h_se) == pytest.approx(math.hypot(0.005, jack), rel=0.02)
-    assert float(m.zeta_h) == pytest.approx(0.025, rel=1e-9)  # the window mean: 1.02 + 0.005
+    assert float(m.zeta_h) == pytest.approx(0.025, rel=1e-9)
+    assert float(m.zeta_h_se) < 1e-12
+    se = [float(case_metrics(*series_run(depth_ramp=0.01, depth_noise=0.002, seed=k)).zeta_h_se) for k in range(100)]
+    assert math.sqrt(np.mean(np.square(se))) == pytest.approx(0.002 / math.sqrt(51), rel=0.20)
 
 
 def test_window_errors_unknown_without_a_matching_record():

@@ -80,7 +80,8 @@ def run_priority(wildcards):
 if FLOW == "conveyor":
     RUN_COMMAND = ("NUMBA_NUM_THREADS={threads} python -m solver front {input.case} -o {output} "
                    "--threads {threads} --quiet --allow-diverged "
-                   "--checkpoint results/checkpoints/{wildcards.case}.ckpt 2> {log}")
+                   "--checkpoint results/checkpoints/{wildcards.case}.ckpt "
+                   "--progress results/progress/{wildcards.case}.json 2> {log}")
 else:
     RUN_COMMAND = ("NUMBA_NUM_THREADS={threads} python -m solver run {input.case} -o {output} "
                    "--threads {threads} --quiet --allow-diverged 2> {log}")

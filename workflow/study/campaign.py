@@ -51,6 +51,8 @@ RUN_NUMBERS = {
     "steady_state_time": ("steady_state_time_s", "s", "start of the steady averaging window"),
     "threads": ("threads", "1", "threads"),
     "cfl_acoustic": ("cfl_acoustic", "1", "C_CFL of the acoustic limit the run used (cfl_rule)"),
+    "started": ("started_unix", "s", "when the run started, seconds since 1970-01-01 UTC"),
+    "ended": ("ended_unix", "s", "when the run ended, seconds since 1970-01-01 UTC"),
 }
 FRONT_XSTAR = 3.0  # particles within this x* of the toe are kept for the front figure
 

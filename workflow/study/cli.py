@@ -185,6 +185,11 @@ def cmd_check_report(a):
         raise SystemExit(1)
 
 
+def cmd_status(a):
+    from .status import show
+    print(show(a.folder, all_cases=a.all))
+
+
 def _write_text(path, text):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -220,6 +225,10 @@ def main(argv=None) -> int:
     p.add_argument("report"); p.add_argument("--screenshot")  # noqa: E702
     p.add_argument("--width", type=int, default=1280); p.add_argument("--height", type=int, default=900)  # noqa: E702
     p.set_defaults(fn=cmd_check_report)
+    p = sub.add_parser("status", help="each running case's simulated time, drift ratios and time left")
+    p.add_argument("--folder", default="results/progress", help="the progress files (default: results/progress)")
+    p.add_argument("--all", action="store_true", help="also the cases that have ended")
+    p.set_defaults(fn=cmd_status)
     a = ap.parse_args(argv)
     from .config import ConfigError
     try:

@@ -4,16 +4,11 @@ x* is measured upslope from the toe in units of the computed normal depth h_n, d
 are h/h_n, velocities u* = (u + u_b)/u_b in the belt frame; all from the steady-window
 means of a run (``mean_*`` variables of the per-run NetCDF).
 
-Sampling errors: zeta_f's from the toe's scatter (``zeta_f_error``); zeta_h's, zeta_fs's and
-zeta_u's by a block jackknife over the averaging window (``window_errors``): the window's
-samples in JACKKNIFE_BLOCKS contiguous blocks, each metric recomputed from the means with one
-block left out, se^2 = (B - 1)/B sum_k (zeta_(k) - mean_k zeta_(k))^2. That measures the
-scatter of the window mean, not a drift: the uniform depth drifts slowly, so zeta_h's se adds
-half the depth's least-squares change through the window T, se_h^2 = se_jack^2 +
-(|dh/dt| T / (2 h_ref))^2. A drifting depth has no single steady value; the window's mean is
-within that of the depth at both its ends. On a depth that does not drift, the fitted slope's
-own noise makes zeta_h's se larger than the window mean's, by a factor of 1.7 on average for
-white noise (tests/test_study.py): conservative.
+Sampling errors (docs/metrics.md, "Standard errors"): each the se of a window mean or slope
+from its series' autocorrelation over the samples before the window (solver.timeseries):
+zeta_f's of the toe's slope over its second (``zeta_f_error``); zeta_h's of the uniform depth's
+mean; zeta_fs's and zeta_u's of the mean of their influence series, the RMS linearised about
+the window's mean curve (``rms_influence``, ``window_errors``).
 
 beyond the paper, a diagnostic beside zeta_f: zeta_f_body, the same error of the equivalent front
 (``front_body_velocity_error``), which tells a front that moves from a toe that wanders.
@@ -29,31 +24,30 @@ def zeta_f(front_velocity: float, u_b: float) -> float:
     return abs(front_velocity) / u_b
 
 
-def last_second_velocity(t, position, u_b: float) -> tuple[float, float]:
+def last_second_velocity(t, position, u_b: float, context: float = 0.0) -> tuple[float, float]:
     """(|slope| / u_b, se / u_b) of a front position's least-squares slope over the last second
-    of the record (the second zeta_f is measured over), se widened for the residuals' lag-1
-    correlation (solver.steady.front_velocity_fit). NaN, NaN with fewer than 4 samples in that
-    second (no scatter to measure)."""
+    of the record (the second zeta_f is measured over), its se reading ``context`` s of the
+    samples before that second as well (solver.steady.front_velocity_fit). NaN, NaN with fewer
+    than 4 samples in that second (no scatter to measure)."""
     from solver.steady import FRONT_VELOCITY_SPAN, front_velocity_fit
     t = np.asarray(t, dtype=float)
     if t.size == 0 or (t >= t[-1] - FRONT_VELOCITY_SPAN - 1e-9).sum() < 4:
         return float("nan"), float("nan")
-    slope, se = front_velocity_fit(t, position)
+    slope, se = front_velocity_fit(t, position, context)
     return abs(slope) / u_b, se / u_b
 
 
-def zeta_f_error(t, toe, u_b: float) -> float:
-    """Standard error of zeta_f from the toe's own scatter (``last_second_velocity``). A wander
-    of the toe slower than the second shows as slope, not scatter."""
-    return last_second_velocity(t, toe, u_b)[1]
+def zeta_f_error(t, toe, u_b: float, context: float = 0.0) -> float:
+    """Standard error of zeta_f from the toe's own series (``last_second_velocity``)."""
+    return last_second_velocity(t, toe, u_b, context)[1]
 
 
-def front_body_velocity_error(t, front, u_b: float) -> tuple[float, float]:
+def front_body_velocity_error(t, front, u_b: float, context: float = 0.0) -> tuple[float, float]:
     """(|u_e| / u_b, se / u_b) of the equivalent front x0 + A / h_n (the fluid area A downstream
     of a lab-fixed point over h_n, ``front_equivalent`` of the run), u_e its slope over zeta_f's
     second (``last_second_velocity``). A front that advances at constant shape moves it as much
     as its toe; the nose's wander and particles joining or leaving the tip do not move it."""
-    return last_second_velocity(t, front, u_b)
+    return last_second_velocity(t, front, u_b, context)
 
 
 def zeta_h(depth: float, h_ref: float) -> float:
@@ -100,9 +94,9 @@ def zeta_u(ref_velocity: xr.DataArray, num_velocity: xr.DataArray) -> float:
     return rms_difference(ref_velocity, num_velocity, "z_star")
 
 
-JACKKNIFE_BLOCKS = 5
-MIN_BLOCK_SAMPLES = 2  # fewer samples a block: the window's errors are not measured (NaN)
+MIN_WINDOW_SAMPLES = 10  # fewer samples in a window: its errors are not measured (NaN)
 PROFILE_METRICS = ("zeta_h", "zeta_h_paper", "zeta_fs")
+DEFAULT_CONTEXT = 15.0  # s: steady.context of a run that does not record its own
 
 
 def profile_metrics(depth: float, surface: xr.DataArray, velocity: xr.DataArray, run: xr.Dataset,
@@ -152,34 +146,84 @@ def holdout_samples(run: xr.Dataset) -> np.ndarray | None:
     return _samples(run, "holdout_start_s", "holdout_end_s", open_start=True)
 
 
-def jackknife_se(leave_one_out: np.ndarray) -> np.ndarray:
-    """Jackknife standard error from the B leave-one-block-out estimates (axis 0)."""
-    b = leave_one_out.shape[0]
-    return np.sqrt((b - 1) / b * ((leave_one_out - leave_one_out.mean(axis=0)) ** 2).sum(axis=0))
+def context_samples(run: xr.Dataset, idx: np.ndarray) -> np.ndarray:
+    """Indices of the samples a window's se reads before the window ``idx``: the run's
+    steady.context s before it, from its steady.min_time on (attrs ``se_context_s`` and
+    ``steady_min_time_s``; without them DEFAULT_CONTEXT and the record's start)."""
+    t = run["time"].values
+    context = float(run.attrs.get("se_context_s", DEFAULT_CONTEXT))
+    t_min = float(run.attrs.get("steady_min_time_s", -np.inf))
+    t0 = t[idx[0]]
+    return np.flatnonzero((t >= max(t0 - context, t_min) - 1e-9) & (t < t0 - 1e-9))
 
 
-def window_errors(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, x_star_range=(0.0, 12.0),
-                  blocks: int = JACKKNIFE_BLOCKS) -> tuple[dict, np.ndarray]:
-    """Block-jackknife standard errors of zeta_h, zeta_h_paper, zeta_fs and zeta_u (per
-    station) over the time samples ``idx`` (contiguous), zeta_h's with the depth's drift
-    (module docstring): NaN where a block would hold fewer than MIN_BLOCK_SAMPLES."""
-    nan = ({k: np.nan for k in PROFILE_METRICS}, np.full(ref["station"].size, np.nan))
-    if idx.size < blocks * MIN_BLOCK_SAMPLES:
-        return nan
-    scalars, zus = [], []
-    for drop in np.array_split(idx, blocks):
-        keep = run.isel(time=np.setdiff1d(idx, drop))
-        s, zu = profile_metrics(float(keep["uniform_depth"].mean("time")), keep["surface_elevation"].mean("time"),
-                                keep["velocity_star"].mean("time"), run, ref, x_star_range)
-        scalars.append([s[k] for k in PROFILE_METRICS])
-        zus.append(zu)
-    se = dict(zip(PROFILE_METRICS, jackknife_se(np.array(scalars))))
-    from solver.steady import trend
-    t = run["time"].values[idx]
-    half_change = 0.5 * abs(trend(t, run["uniform_depth"].values[idx])) * (t[-1] - t[0])
-    for k, h_ref in (("zeta_h", run.attrs["h_n_m"]), ("zeta_h_paper", run.attrs["normalising_depth_m"])):
-        se[k] = float(np.hypot(se[k], half_change / float(h_ref)))
-    return se, jackknife_se(np.array(zus))
+def _column_means(a: np.ndarray) -> np.ndarray:
+    """Means over axis 0 of the finite values (NaN for a column with none, without a warning)."""
+    ok = np.isfinite(a)
+    n = ok.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, np.where(ok, a, 0.0).sum(axis=0) / n, np.nan)
+
+
+def _on_reference(x_ref, x_run, rows) -> np.ndarray:
+    """Each row of ``rows`` (a curve over x_run) on the reference abscissas (``on_abscissas``)."""
+    return np.array([on_abscissas(x_ref, x_run, r) for r in rows]).reshape(len(rows), np.size(x_ref))
+
+
+def rms_influence(reference: np.ndarray, mean_curve: np.ndarray, curves: np.ndarray) -> np.ndarray:
+    """The first-order change of the RMS error sqrt(mean_x (c_x - r_x)^2) about the mean curve
+    when the curve is one sample's: sum_x d_x (c_x(t) - cbar_x) / (N_x rms), d = cbar - r, over the
+    abscissas where the mean curve and the reference are defined (a sample's undefined points
+    count as the mean's). Its window mean's se is the RMS error's (delta method)."""
+    d = mean_curve - reference
+    ok = np.isfinite(d)
+    if not ok.any():
+        return np.full(len(curves), np.nan)
+    rms = float(np.sqrt(np.mean(d[ok] ** 2)))
+    if rms == 0.0:
+        return np.zeros(len(curves))
+    dev = np.where(np.isfinite(curves[:, ok]), curves[:, ok] - mean_curve[ok], 0.0)
+    return dev @ d[ok] / (ok.sum() * rms)
+
+
+def metric_series(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, samples: np.ndarray,
+                  x_star_range=(0.0, 12.0)) -> tuple[np.ndarray, np.ndarray]:
+    """Over ``samples``: the uniform depth / h_n (column 0), the influence series of zeta_fs
+    (column 1) and of zeta_u at each station (columns 2...), linearised about the means over the
+    window ``idx`` (``rms_influence``): (time, series)."""
+    hn = float(run.attrs["h_n_m"])
+    lo, hi = x_star_range
+    ref_s = ref["surface"].sel(x_star=slice(lo, hi))
+    xr_, xs = ref_s["x_star"].values, run["x_star"].values
+    surf = run["surface_elevation"].values / hn
+    cols = [run["uniform_depth"].values[samples] / hn,
+            rms_influence(ref_s.values, on_abscissas(xr_, xs, _column_means(surf[idx])),
+                          _on_reference(xr_, xs, surf[samples]))]
+    vel, z = run["velocity_star"], run["z_star"].values
+    for s in ref["station"].values:
+        ref_u = ref["velocity"].sel(station=s)
+        v = vel.sel(station=s, method="nearest").values
+        cols.append(rms_influence(ref_u.values, on_abscissas(ref_u["z_star"].values, z, _column_means(v[idx])),
+                                  _on_reference(ref_u["z_star"].values, z, v[samples])))
+    return run["time"].values[samples], np.array(cols)
+
+
+def window_errors(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray,
+                  x_star_range=(0.0, 12.0)) -> tuple[dict, np.ndarray]:
+    """Standard errors of zeta_h, zeta_h_paper, zeta_fs and zeta_u (per station) over the
+    window of time samples ``idx`` (contiguous): each the se of its series' window mean
+    (``metric_series``, solver.timeseries.window_fits), its autocorrelation read over the window
+    and the samples before it (``context_samples``). NaN with fewer than MIN_WINDOW_SAMPLES."""
+    if idx.size < MIN_WINDOW_SAMPLES:
+        return {k: np.nan for k in PROFILE_METRICS}, np.full(ref["station"].size, np.nan)
+    from solver.timeseries import window_fits
+    lead = context_samples(run, idx)
+    t, ys = metric_series(run, ref, idx, np.concatenate([lead, idx]), x_star_range)
+    _, se, _, _ = window_fits(t, ys, lead.size)
+    hn = float(run.attrs["h_n_m"])
+    out = {"zeta_h": float(se[0]), "zeta_h_paper": float(se[0]) * hn / float(run.attrs["normalising_depth_m"]),
+           "zeta_fs": float(se[1])}
+    return out, se[2:]
 
 
 HOLDOUT_METRICS = ("zeta_f", "zeta_h", "zeta_fs")
@@ -189,13 +233,24 @@ def holdout_metrics(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, x_star_ra
     """zeta_f, zeta_h, zeta_fs and zeta_u over the samples ``idx`` (the hold-out window), each
     with its standard error as over the averaging window: ({name: (value, se)}, zeta_u, its se)."""
     sub = run.isel(time=idx)
-    t, ub = sub["time"].values, float(run.attrs["belt_speed_m_s"])
+    ub = float(run.attrs["belt_speed_m_s"])
     s, zu = profile_metrics(float(sub["uniform_depth"].mean("time")), sub["surface_elevation"].mean("time"),
                             sub["velocity_star"].mean("time"), run, ref, x_star_range)
     se, zu_se = window_errors(run, ref, idx, x_star_range)
     out = {k: (s[k], se[k]) for k in ("zeta_h", "zeta_fs")}
-    out["zeta_f"] = last_second_velocity(t, sub["toe_position"].values, ub)
+    t, toe, context = _front_record(run, idx[-1] + 1)
+    out["zeta_f"] = last_second_velocity(t, toe, ub, context)
     return out, zu, zu_se
+
+
+def _front_record(run: xr.Dataset, end: int, name: str = "toe_position"):
+    """(time, the front series ``name``, the se's context [s]) of the samples before index
+    ``end``, from the run's steady.min_time on (``context_samples``)."""
+    t = run["time"].values[:end]
+    keep = t >= float(run.attrs.get("steady_min_time_s", -np.inf)) - 1e-9
+    if keep.sum() < 4:
+        keep[:] = True
+    return t[keep], run[name].values[:end][keep], float(run.attrs.get("se_context_s", DEFAULT_CONTEXT))
 
 
 def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
@@ -222,11 +277,11 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
         idx = window_samples(run)
         if "toe_position" in run:  # zeta_f's second: the window's last (the record's, without a window)
             end = idx[-1] + 1 if idx is not None else run.sizes["time"]
-            t = run["time"].values[:end]
-            out["zeta_f_se"] = zeta_f_error(t, run["toe_position"].values[:end], ub)
+            t, toe, context = _front_record(run, end)
+            out["zeta_f_se"] = zeta_f_error(t, toe, ub, context)
             if "front_equivalent" in run:
-                out["zeta_f_body"], out["zeta_f_body_se"] = front_body_velocity_error(
-                    t, run["front_equivalent"].values[:end], ub)
+                t, front, context = _front_record(run, end, "front_equivalent")
+                out["zeta_f_body"], out["zeta_f_body_se"] = front_body_velocity_error(t, front, ub, context)
         surf = run["mean_surface_elevation"]
         vel = run["mean_velocity_star"]
         scalars, zu = profile_metrics(float(run["mean_uniform_depth"]), surf, vel, run, ref, x_star_range)
@@ -257,20 +312,18 @@ def case_metrics(run: xr.Dataset, ref: xr.Dataset, x_star_range=(0.0, 12.0),
     ds["steady"].attrs.update(units="1", long_name="1: metrics over a steady window; 0: not steady or no metrics")
     attrs = {
         "zeta_f": "front velocity error |u*_f - u*_b| / u*_b",
-        "zeta_f_se": "standard error of zeta_f from the toe's scatter over its second",
+        "zeta_f_se": "standard error of zeta_f: of the toe's slope over its second",
         "zeta_f_body": "front velocity error of the front's body: |u_e| / u_b, u_e the equivalent "
                        "front's velocity over zeta_f's second (not the paper's metric; a diagnostic)",
-        "zeta_f_body_se": "standard error of zeta_f_body from the equivalent front's scatter over its second",
+        "zeta_f_body_se": "standard error of zeta_f_body: of the equivalent front's slope over its second",
         "zeta_h": "uniform depth error against the computed h_n",
         "zeta_h_paper": "uniform depth error against the paper's normalising depth",
         "zeta_fs": "free-surface RMS error against the theory",
         "zeta_u": "velocity-profile RMS error against the theory",
-        "zeta_h_se": "standard error of zeta_h over the averaging window (block jackknife and half "
-                     "the depth's drift through it)",
-        "zeta_h_paper_se": "standard error of zeta_h_paper over the averaging window (block jackknife "
-                           "and half the depth's drift through it)",
-        "zeta_fs_se": "standard error of zeta_fs over the averaging window (block jackknife)",
-        "zeta_u_se": "standard error of zeta_u over the averaging window (block jackknife)",
+        "zeta_h_se": "standard error of zeta_h: of the window mean of the uniform depth",
+        "zeta_h_paper_se": "standard error of zeta_h_paper: of the window mean of the uniform depth",
+        "zeta_fs_se": "standard error of zeta_fs: of the window mean of its influence series",
+        "zeta_u_se": "standard error of zeta_u: of the window mean of its influence series",
         "zeta_fs_measured": "free-surface RMS error against measured data",
         "zeta_u_measured": "velocity-profile RMS error against measured data",
         **{f"{k}_holdout": f"{k} over the hold-out window (the window after the averaging window)"

@@ -377,9 +377,9 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                f"zeta_h is given against the computed normal depth h_n = "
                f"{_fmt(ds.attrs.get('h_n_m', np.nan) * 1000, 4)} mm and against the paper's "
                f"normalising depth {_fmt(ds.attrs.get('normalising_depth_m', np.nan) * 1000, 4)} mm. "
-               "&plusmn; 2 se: the sampling error of a run's window (zeta_f: from the toe's scatter; "
-               "zeta_h, zeta_fs, zeta_u: a block jackknife over the window, zeta_h's with half the "
-               "depth's drift through it). It is not the discretisation error, and the verdicts and "
+               "&plusmn; 2 se: the sampling error of a run's window, from each metric's series and its "
+               "autocorrelation over the seconds before the window (docs/metrics.md, 'Standard "
+               "errors'). It is not the discretisation error, and the verdicts and "
                "the cheapest runs use it: a value is below a threshold only by more than 2 se, two "
                "runs within 2 se tie. Nor does it hold how far a metric wanders from one window to the "
                "next: the case table's hold-out column shows where a run's metrics moved by more than "
@@ -421,8 +421,18 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     ensemble = "" if ensemble_size(ds) <= 1 else (
         f" ({int(np.sum(ds['realisations'].values > 0))} grid points; {ensemble_counts(ds)})")
     lead = (f"<p class='lead'>{n} cases{ensemble}, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
-            f"{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
+            f"{campaign_wall(ds)}{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
     return page("sph-surge campaign report", "sph-surge campaign report", lead, body)
+
+
+def campaign_wall(ds: xr.Dataset) -> str:
+    """'the runs took X min of wall time (first start to last end); ' or '' where unrecorded."""
+    if "case_started" not in ds or "case_ended" not in ds:
+        return ""
+    start, end = np.nanmin(ds["case_started"].values), np.nanmax(ds["case_ended"].values)
+    if not (np.isfinite(start) and np.isfinite(end)):
+        return ""
+    return f"the runs took {(end - start) / 60:.1f} min of wall time (first start to last end); "
 
 
 def figure_html(path, title: str, caption: str) -> str:

@@ -11,8 +11,8 @@ Verdicts:
   the extrapolation does not rule the threshold out);
 - ``no data``: the runs the claim needs are missing or diverged.
 A verdict whose evidence includes runs that were not steady says so (``unsteady``).
-A metric with a sampling error in the campaign dataset (``{var}_se``: zeta_f from the toe's
-scatter; zeta_h, zeta_fs and zeta_u per station by the block jackknife of study.metrics) is
+A metric with a sampling error in the campaign dataset (``{var}_se``: the se of the window mean or
+slope of each metric's series, study.metrics and solver.timeseries) is
 below or above a threshold only by more than 2 se, and two runs within 2 se of each other
 tie; a run whose sampling error could not be measured (NaN: too few samples) is neither below
 nor above, and ties. Along dp, a change within 2 se of its two runs counts as none (``trend``).

@@ -2,7 +2,7 @@
 
 Every error is an RMS over samples (times of a front, abscissas of a profile) of a deviation
 d_i. Its sampling error comes from the scatter of d_i^2 about a least-squares line through
-them, with their lag-1 correlation (solver.steady.line_fits): se(mean d^2) / (2 RMS). It is
+them, from their autocorrelation (solver.steady.line_fits): se(mean d^2) / (2 RMS). It is
 the particle noise of the measurement, not the discretisation error.
 """
 from __future__ import annotations

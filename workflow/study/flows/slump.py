@@ -69,8 +69,8 @@ def depth_profile(x, t: float, A: float, nu: float, g: float):
 
 def fit_front_exponent(t, x_front, interval=(0.0, math.inf)) -> tuple[float, float]:
     """(b, se) of the least-squares line ln x_N = a + b ln t over the samples with t in the
-    closed ``interval`` and t, x_N > 0 finite; se widened for the residuals' lag-1 correlation
-    as every fitted trend of the project (solver.steady.trend_bound). The similarity solution
+    closed ``interval`` and t, x_N > 0 finite; se from the residuals' autocorrelation as every
+    fitted trend of the project (solver.steady.trend_bound). The similarity solution
     has b = 1/5; a front x_N = c (t + t_v)^(1/5) has the local exponent t / (5 (t + t_v)),
     within 1 % of 1/5 only past ``exponent_time``. NaN, NaN with fewer than 3 samples."""
     from solver.steady import trend_bound
