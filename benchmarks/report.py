@@ -22,6 +22,7 @@ BENCHMARKS = [
     ("kernel_times", [], False),
     ("time_to_solution", [], True),
     ("window_metrics", [], True),
+    ("window_metrics", ["--calibrate"], True),
     ("paper_grid", [], True),
     ("viscous_limit", [], False),
     ("acoustic_edge", [], True),

@@ -49,7 +49,7 @@ class Steady:
     average: float = 3.0  # W [s]: the averaging window and its hold-out window, each (solver/steady.py)
     fraction: float = 5.0e-4  # a drift below this fraction of a quantity's value passes however small its se
     max_time: float = 30.0  # s: give up (status not_steady) after this
-    min_time: float = 0.0  # s after the end of the belt ramp before the averaging window may start
+    min_time: float = 3.0  # s after the end of the belt ramp: the start-up, never averaged nor read as context
     stop: bool = True  # false: run to max_time; the window pair is the final 2W (fixed end time)
     context: float = 15.0  # s of samples before each window (from min_time on) that its se reads
 

@@ -235,11 +235,12 @@ def test_the_start_check_sets_both_starts_side_by_side_and_says_whether_they_agr
     from study.report import start_check_section
     tab = startcheck.table(start_check_campaign(0.001))
     assert list(tab["check"].values) == ["dp1mm_ch1.8_skillen_paper-start"]
-    assert bool(tab["agree"].all()) and "every metric agrees within 2 se" in start_check_section(
+    assert bool(tab["agree"].all()) and "the two starts agree within 2 se on every metric" in start_check_section(
         start_check_campaign(0.001))
     tab = startcheck.table(start_check_campaign(0.002))
     moved = [str(m) for m, a in zip(tab["metric"].values, tab["agree"].values[0]) if not a]
     assert moved == ["zeta_h"]
     text = start_check_section(start_check_campaign(0.002))
-    assert "1 of 6 metrics differ by more than 2 se (zeta_h)" in text and "0.2 %" in text
+    assert "<b>differ</b> on 1 of 6 metrics by more than 2 se (zeta_h): a real difference" in text
+    assert "0.2 %" in text
     assert start_check_section(start_check_campaign(0.0).isel(case=[0])) == ""

@@ -97,7 +97,8 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisati
             stem = c.id.rsplit("_r", 1)[0]
             extra = {"name": c.id, "start_perturbation": 1e-3, "perturbation_seed": c.realisation,
                      "steady": {**base[stem]["steady"],
-                                "min_time": base[stem]["steady"].get("min_time", 0.0) + 0.25 * c.realisation}}
+                                "min_time": base[stem]["steady"].get("min_time", cfgmod.default_min_time())
+                                + 0.25 * c.realisation}}
             assert d == {**base[stem], **extra}, c.id
 
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.se_calibration import DT, WINDOW, ar1
+from benchmarks.window_metrics import DT, WINDOW, ar1
 from solver.conveyor import Steady
 from solver.timeseries import window_fits
 

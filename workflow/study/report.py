@@ -121,8 +121,9 @@ def start_check_section(ds: xr.Dataset) -> str:
         if all(np.isfinite(since)):
             note += f"; averaging windows from {since[0]:.1f} s and {since[1]:.1f} s"
         out.append(f"<p><b>{html.escape(str(row['own_case'].values))}</b> against <b>{html.escape(str(c))}</b>: "
-                   + ("every metric agrees within 2 se" if ok else f"{len(moved)} of {agree.size} metrics "
-                      f"differ by more than 2 se ({html.escape(', '.join(moved))})")
+                   + ("the two starts agree within 2 se on every metric" if ok else
+                      f"the two starts <b>differ</b> on {len(moved)} of {agree.size} metrics by more than 2 se "
+                      f"({html.escape(', '.join(moved))}): a real difference, not sampling noise")
                    + note + ".</p>")
         cells = "".join(
             f"<tr><td class='l'>{html.escape(str(m))}</td>"
@@ -135,10 +136,12 @@ def start_check_section(ds: xr.Dataset) -> str:
                    "<th>paper's start (&plusmn; 2 se)</th><th>difference (&plusmn; 2 se)</th>"
                    f"<th>within 2 se</th></tr>{cells}</table>")
     return ("<p>At the finest dp, each shifting method ran once more from the paper's start: a block at rest "
-            "at the normal depth, the belt ramped up from rest. Where the two runs agree, the answer does not "
-            "depend on the start. Where they differ, compare with the case table's hold-out column: a metric "
-            "that also moves from a run's averaging window to its hold-out wanders by more than one "
-            "window's se, and two runs averaged at different times differ by that wander.</p>" + "".join(out))
+            "at the normal depth, the belt ramped up from rest. Each se holds the metric's wander from one "
+            "window to the next (its autocorrelation over the seconds before the window, calibrated on runs "
+            "carried on for 110 s: docs/metrics.md). Where the two runs agree within 2 se, the answer does not "
+            "depend on the start. Where they differ by more, the difference is real: the start changes the "
+            "answer, or one of the runs was averaged before its steady state (its hold-out column says if a "
+            "metric moved after the window).</p>" + "".join(out))
 
 
 def convergence_table(ds: xr.Dataset) -> str:
