@@ -1,5 +1,5 @@
-"""Projected wall time of a campaign's grid runs (default config/paper.yaml; its start checks are not
-included) on this host, from short runs.
+"""Projected wall time of a campaign's grid runs and start checks (default config/paper.yaml) on this
+host, from short runs.
 
 Each grid case of the config runs --time s of simulated time (--fine-time below dp = 0.4 mm) on
 --threads threads, after a compile run, from the solver case file the campaign writes for it
@@ -10,10 +10,11 @@ and a case then costs
     wall = start-up + T_sim / dt * N / rate
 
 with T_sim from --t-sim (T, METHOD=T or METHOD@DP_MM=T: the simulated time at which a run ends
-steady, the end of its hold-out window; by default 12.5 s for Skillen and 16.5 s for Lind, what
-the default campaign's dp = 1 mm runs from the lubrication start took) and, as the upper bound,
-the case's steady.max_time. Realisations of an
-ensemble cost what their case does. --coarse-only measures the coarsest dp at every Ch and the
+steady, the end of its hold-out window; a start check's METHOD is e.g. ``skillen-paper``, and
+falls back to the method's) and, as the upper bound, the case's steady.max_time. The defaults
+are what the default campaign's dp = 1 mm runs took (docs/conveyor.md's campaign table). A start
+check costs what its grid case does per simulated second. Realisations of an ensemble cost what
+their case does. --coarse-only measures the coarsest dp at every Ch and the
 finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at another Ch takes
 its paper-Ch run's dt, rate and N times their Ch ratio at the coarsest dp.
 
@@ -77,15 +78,29 @@ def measure(data: dict, sets, sim_time: float) -> dict:
             "rate": n * steps / stepping, "update": str(a.get("viscous_update", "")), "status": a["status"]}
 
 
+T_SIM = ["12.5"]  # s, every case: --t-sim's default before the entries below
+T_SIM_MEASURED = ["skillen=12.6", "lind=12.9", "skillen-paper=15.1", "lind-paper=14.3"]  # config/config.yaml, dp = 1 mm
+
+
 def t_sim_of(specs, method: str, dp: float) -> float:
-    """T_sim of a case from --t-sim entries: T, METHOD=T or METHOD@DP_MM=T, the most specific wins."""
+    """T_sim of a case from --t-sim entries: T, METHOD=T or METHOD@DP_MM=T, the most specific wins;
+    a start check's METHOD (``skillen-paper``) falls back to its method's entries."""
     best, rank = 12.5, -1
+    names = [method] + ([method.split("-")[0]] if "-" in method else [])
     for s in specs:
         key, _, value = s.rpartition("=")
-        r = 0 if not key else 2 if key == f"{method}@{dp * 1e3:g}" else 1 if key == method else -1
-        if r > rank:
-            best, rank = float(value), r
+        for depth, name in enumerate(names):  # the start check's own entries outrank its method's
+            r = (-1 if key not in ("", name, f"{name}@{dp * 1e3:g}") else 0 if not key
+                 else 2 * (2 - depth) if key == f"{name}@{dp * 1e3:g}" else 2 * (2 - depth) - 1)
+            if r > rank:
+                best, rank = float(value), r
     return best
+
+
+def start_checks(cfg: dict) -> list[tuple[float, float, str]]:
+    """(dp, ch, method) of the campaign's start checks (study.config.start_checks)."""
+    from study.config import START_CHECK_TAG, cases
+    return [(c.dp, c.ch, c.shifting) for c in cases(cfg) if c.tag == START_CHECK_TAG]
 
 
 def main(argv=None) -> int:
@@ -93,7 +108,7 @@ def main(argv=None) -> int:
     ap.add_argument("--config", type=Path, default=common.ROOT / "config" / "paper.yaml")
     ap.add_argument("--time", type=float, default=0.05, help="simulated seconds of each run")
     ap.add_argument("--fine-time", type=float, default=0.02, help="simulated seconds below dp = 0.4 mm")
-    ap.add_argument("--t-sim", nargs="+", default=["12.5", "lind=16.5"], metavar="[METHOD[@DP_MM]=]T")
+    ap.add_argument("--t-sim", nargs="+", default=T_SIM + T_SIM_MEASURED, metavar="[METHOD[@DP_MM]=]T")
     ap.add_argument("--shifting", nargs="+", default=None, help="only these methods' cases (default: all)")
     ap.add_argument("--coarsest", type=int, default=None, metavar="N", help="only the N coarsest dp (default: all)")
     ap.add_argument("--paper-ch-only", action="store_true", help="only the paper Ch")
@@ -144,14 +159,24 @@ def main(argv=None) -> int:
         total, total_max = total + to_steady, total_max + to_max
         rows.append([f"{dp * 1e3:g}", f"{ch:g}", m, count, how, f"{dt:.3g}", f"{rate / 1e6:.2f}", f"{ts:g}",
                      f"{to_steady / 3600:.2f}", f"{max_time:g}", f"{to_max / 3600:.2f}"])
-    rows.append(["total", "", "", sum(n for _, n in grid.values()), "", "", "", "", f"{total / 3600:.2f}", "",
-                 f"{total_max / 3600:.2f}"])
+    checks = [k for k in start_checks(cfg) if k in grid and (k in runs or (k[0], pch, k[2]) in runs)]
+    for dp, ch, m in checks:  # a start check: its grid case's cost per simulated second
+        own = runs.get((dp, ch, m)) or runs[(dp, pch, m)]
+        ts, max_time = t_sim_of(a.t_sim, f"{m}-paper", dp), float(grid[(dp, ch, m)][0]["steady"].get("max_time", 30))
+        per_second = own["particles"] / (own["dt"] * own["rate"])
+        to_steady, to_max = own["startup"] + min(ts, max_time) * per_second, own["startup"] + max_time * per_second
+        total, total_max = total + to_steady, total_max + to_max
+        rows.append([f"{dp * 1e3:g}", f"{ch:g}", f"{m}, paper's start", 1, "as its grid case", f"{own['dt']:.3g}",
+                     f"{own['rate'] / 1e6:.2f}", f"{ts:g}", f"{to_steady / 3600:.2f}", f"{max_time:g}",
+                     f"{to_max / 3600:.2f}"])
+    n_runs = sum(n for _, n in grid.values()) + len(checks)
+    rows.append(["total", "", "", n_runs, "", "", "", "", f"{total / 3600:.2f}", "", f"{total_max / 3600:.2f}"])
     print()
     print(common.table(["dp [mm]", "Ch", "shifting", "runs", "how", "dt [s]", "M particle-steps/s", "T_sim [s]",
                         "to steady + window [h]", "max_time [s]", "to max_time [h]"], rows))
     part = (" and ".join(sorted({k[2] for k in grid})) + ", dp " + ", ".join(f"{dp * 1e3:g}" for dp in dps) + " mm, Ch "
             + ", ".join(f"{ch:g}" for ch in sorted({k[1] for k in grid})))
-    common.summary(f"{a.config.name} ({part}), one run at a time on {a.threads} threads: "
+    common.summary(f"{a.config.name} ({part}, {len(checks)} start checks), one run at a time on {a.threads} threads: "
                    f"{total / 3600:.1f} h to steady (T_sim {' '.join(a.t_sim)} s), "
                    f"{total_max / 3600:.1f} h to max_time")
     return 0

@@ -28,7 +28,7 @@ import numpy as np
 C_SOKAL = 5.0  # Sokal's window: the autocorrelation is summed to M >= C tau(M)
 LINE_BIAS = 2.0  # residuals about a fitted line: gamma_k is low by about 2 V / N (module docstring)
 FLOOR = 0.25  # a variance is at least this fraction of the uncorrelated series' (anticorrelated samples)
-MAX_CORRECTION = 8.0  # the window stops before the correction 1 / (1 - 2 (2M + 1) / N) exceeds this
+MAX_CORRECTION = 4.0  # the window stops before the correction 1 / (1 - 2 (2M + 1) / N) exceeds this
 
 
 def window_fits(t, ys, lead: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

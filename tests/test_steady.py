@@ -46,7 +46,7 @@ def first_steady(rec: Record, crit=CRIT):
     det = SteadyDetector(crit)
     for k in range(rec.t.size):
         sub = Record(rec.t[:k + 1], rec.toe[:k + 1], rec.depth[:k + 1], rec.surface[:k + 1], rec.stations[:k + 1])
-        if det.update(sub if k == 0 else sub.span(rec.t[k] - 2.0 * crit.window - DT)):
+        if det.update(sub if k == 0 else sub.span(rec.t[k] - 2.0 * crit.window - crit.context - DT)):
             return det.found
     return None
 
@@ -122,7 +122,7 @@ def monitor_with(rec: Record, stop: bool):
     with open(EXAMPLES / "conveyor.yaml") as fh:
         d = yaml.safe_load(fh)
     d.update(dp=0.004, ch=1.5)
-    d["steady"].update(stop=stop, max_time=float(rec.t[-1]), average=1.0)
+    d["steady"].update(stop=stop, max_time=float(rec.t[-1]), average=1.0, min_time=0.0)
     m = FrontMonitor(case_from_dict(d))
     hn = m.case.h_n
     n = rec.t.size

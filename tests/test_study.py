@@ -297,8 +297,9 @@ def _series_theory():
 
 def test_window_errors_recover_white_noise():
     """zeta_h's and zeta_u's se are the standard error of the window mean, sigma / sqrt(n) (times
-    the RMS of u*_ref over the heights for zeta_u): their RMS over 200 records of white noise
-    within 20 % (solver.timeseries reads a record this short as its own context: measured +15 %)."""
+    the RMS of u*_ref over the heights for zeta_u): their RMS over 200 records of white noise of
+    51 samples within 0.9-1.35 of it (a record this short is its own context; solver.timeseries
+    then overstates white noise, measured 1.15)."""
     n, sd_h, sd_u = 51, 0.004, 0.01
     se_h, se_u = [], []
     for seed in range(200):
@@ -306,10 +307,10 @@ def test_window_errors_recover_white_noise():
         m = case_metrics(run, ref)
         se_h.append(float(m.zeta_h_se))
         se_u.append(m.zeta_u_se.values)
-    assert math.sqrt(np.mean(np.square(se_h))) == pytest.approx(sd_h / math.sqrt(n), rel=0.20)
+    assert 0.9 <= math.sqrt(np.mean(np.square(se_h))) / (sd_h / math.sqrt(n)) <= 1.35
     u = ref["velocity"].sel(station=9.7).values
     rms_u = math.sqrt(np.nanmean(u ** 2))
-    assert math.sqrt(np.mean(np.square(se_u), axis=0)[2]) == pytest.approx(sd_u / math.sqrt(n) * rms_u, rel=0.20)
+    assert 0.9 <= math.sqrt(np.mean(np.square(se_u), axis=0)[2]) / (sd_u / math.sqrt(n) * rms_u) <= 1.35
     # a noiseless record has no sampling error
     m = case_metrics(*series_run())
     assert float(m.zeta_h_se) < 1e-12 and float(m.zeta_fs_se) < 1e-12 and np.all(m.zeta_u_se.values < 1e-12)
@@ -344,14 +345,15 @@ def test_metrics_over_the_hold_out_window_and_where_they_move():
 
 def test_window_errors_are_the_scatter_about_the_line():
     """A depth ramping by 1 % h_n through the window: zeta_h is the window mean's (1.02 + 0.005);
-    its se is that of the scatter about the fitted line (0 without noise, sigma / sqrt(n) within
-    20 % over 100 records with it): a drift is the steady detection's to judge, not a sampling error."""
+    its se is that of the scatter about the fitted line (0 without noise, 0.9-1.35 sigma / sqrt(n)
+    over 100 records with it, as for white noise): a drift is the steady detection's to judge, not
+    a sampling error."""
     run, ref = series_run(depth_ramp=0.01)
     m = case_metrics(run, ref)
     assert float(m.zeta_h) == pytest.approx(0.025, rel=1e-9)
     assert float(m.zeta_h_se) < 1e-12
     se = [float(case_metrics(*series_run(depth_ramp=0.01, depth_noise=0.002, seed=k)).zeta_h_se) for k in range(100)]
-    assert math.sqrt(np.mean(np.square(se))) == pytest.approx(0.002 / math.sqrt(51), rel=0.20)
+    assert 0.9 <= math.sqrt(np.mean(np.square(se))) / (0.002 / math.sqrt(51)) <= 1.35
 
 
 def test_window_errors_unknown_without_a_matching_record():
