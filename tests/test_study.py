@@ -479,7 +479,7 @@ def test_zeta_f_of_the_front_body_reads_the_fronts_motion_not_the_toes_jumps():
     """A front creeping at 0.3 % u_b whose equivalent front carries white noise of 0.01 mm and
     whose toe, on the same creep, jumps 4 mm ahead for the last 0.3 s (a particle strung
     ahead of the nose) and scatters by 0.5 mm: case_metrics' zeta_f_body recovers the creep
-    within 2 of its se in 90-99 of 100 records (95 expected; measured 94), its se below 0.02 %,
+    within 2 of its se in 90-99 of 100 records (95 expected; measured 92), its se below 0.02 %,
     while zeta_f reads the jump (median error above 2 %).
     Without the equivalent front in the record (metrics of an older run) it is NaN."""
     u_b, creep = 0.075, 0.003
@@ -491,6 +491,7 @@ def test_zeta_f_of_the_front_body_reads_the_fronts_motion_not_the_toes_jumps():
         front = 0.377 + creep * u_b * t + rng.normal(0.0, 1e-5, t.size)
         toe = 0.391 + creep * u_b * t + np.where(t > 3.7, 0.004, 0.0) + rng.normal(0.0, 5e-4, t.size)
         r = run.assign_coords(time=t).assign(toe_position=("time", toe), front_equivalent=("time", front))
+        r.attrs["steady_min_time_s"] = 0.0  # stationary from t = 0: no start-up to leave out
         r["front_velocity"] = ((), float(np.polyfit(t[t >= 3.0 - 1e-9], toe[t >= 3.0 - 1e-9], 1)[0]))
         m = case_metrics(r, ref)
         covered += abs(float(m.zeta_f_body) - creep) <= 2 * float(m.zeta_f_body_se)

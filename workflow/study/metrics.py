@@ -97,6 +97,7 @@ def zeta_u(ref_velocity: xr.DataArray, num_velocity: xr.DataArray) -> float:
 MIN_WINDOW_SAMPLES = 10  # fewer samples in a window: its errors are not measured (NaN)
 PROFILE_METRICS = ("zeta_h", "zeta_h_paper", "zeta_fs")
 DEFAULT_CONTEXT = 15.0  # s: steady.context of a run that does not record its own
+DEFAULT_MIN_TIME = 3.0  # s: steady.min_time of a run that does not record its own (the start-up)
 
 
 def profile_metrics(depth: float, surface: xr.DataArray, velocity: xr.DataArray, run: xr.Dataset,
@@ -149,10 +150,10 @@ def holdout_samples(run: xr.Dataset) -> np.ndarray | None:
 def context_samples(run: xr.Dataset, idx: np.ndarray) -> np.ndarray:
     """Indices of the samples a window's se reads before the window ``idx``: the run's
     steady.context s before it, from its steady.min_time on (attrs ``se_context_s`` and
-    ``steady_min_time_s``; without them DEFAULT_CONTEXT and the record's start)."""
+    ``steady_min_time_s``; without them DEFAULT_CONTEXT and DEFAULT_MIN_TIME)."""
     t = run["time"].values
     context = float(run.attrs.get("se_context_s", DEFAULT_CONTEXT))
-    t_min = float(run.attrs.get("steady_min_time_s", -np.inf))
+    t_min = float(run.attrs.get("steady_min_time_s", DEFAULT_MIN_TIME))
     t0 = t[idx[0]]
     return np.flatnonzero((t >= max(t0 - context, t_min) - 1e-9) & (t < t0 - 1e-9))
 
@@ -247,7 +248,7 @@ def _front_record(run: xr.Dataset, end: int, name: str = "toe_position"):
     """(time, the front series ``name``, the se's context [s]) of the samples before index
     ``end``, from the run's steady.min_time on (``context_samples``)."""
     t = run["time"].values[:end]
-    keep = t >= float(run.attrs.get("steady_min_time_s", -np.inf)) - 1e-9
+    keep = t >= float(run.attrs.get("steady_min_time_s", DEFAULT_MIN_TIME)) - 1e-9
     if keep.sum() < 4:
         keep[:] = True
     return t[keep], run[name].values[:end][keep], float(run.attrs.get("se_context_s", DEFAULT_CONTEXT))
