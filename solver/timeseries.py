@@ -1,22 +1,27 @@
 """Standard errors of a window's mean and least-squares slope for an autocorrelated series
 (steady-state output analysis; pure functions).
 
-A window holds n samples y_1..y_n at equal spacing; the context is the window and the samples
-before it. With gamma_k the autocovariance of the series at lag k,
+A window holds n samples y_1..y_n at equal spacing; its context is the samples before it. With
+gamma_k the autocovariance of the series at lag k,
 
   Var(mean)  = (1/n^2) sum_ij gamma_|i-j| = (1/n) [gamma_0 + 2 sum_{k=1}^{M} (1 - k/n) gamma_k]
   Var(slope) = sum_ij w_i w_j gamma_|i-j|,   w_i = (t_i - tbar) / sum_i (t_i - tbar)^2,
 
 the finite-window forms, which hold however long the correlation is against the window.
-gamma_k is estimated from the residuals about the least-squares line over the whole context
-(N samples), gamma_k = sum_i e_i e_(i+k) / N, gamma_0 = sum e_i^2 / (N - 2), and cut at Sokal's
-automatic window M, the smallest lag with M >= C tau(M), tau(M) = 1 + 2 sum_{k<=M} rho_k (C = 5;
-as emcee.autocorr.integrated_time), M < n. The sum stops where the correlation has died out:
-the noise of the estimated gamma_k at longer lags is not summed. A Var below the uncorrelated
-series' gamma_0 / n (anticorrelated samples) is raised to it.
+gamma_k is estimated from the residuals e about the least-squares line over N samples: the
+context where it holds at least n samples, else the context and the window together (so an
+event inside the window is judged against what came before it). gamma_k = sum_i e_i e_(i+k) / N
+is low by about 2 V / N, V = gamma_0 + 2 sum_{k<=M} gamma_k the long-run variance, because the
+line was fitted to the same samples; each gamma_k is raised by that, V solved for with it,
+V = V_raw / (1 - 2 (2M + 1) / N). The sum stops at Sokal's window M, the smallest lag with
+M >= C tau(M), tau(M) = V / gamma_0 (C = 5, as emcee.autocorr.integrated_time), M < n, and
+before the correction exceeds MAX_CORRECTION. A variance below FLOOR times the uncorrelated
+series' (anticorrelated samples) is raised to it.
 
-A context only as long as the window cannot see a correlation as long as the window: the
-callers pass the samples before the window (solver/steady.py, study/metrics.py say how many).
+A window alone cannot see a correlation as long as itself: callers pass up to
+``steady.context`` s of samples before it (solver/steady.py, study/metrics.py). A context of a
+few seconds still reads a 1 s correlation short (the se low by about half with 3 s), and a
+transient inside the context widens the se until it leaves it.
 """
 from __future__ import annotations
 
