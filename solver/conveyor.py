@@ -49,7 +49,12 @@ class Steady:
     average: float = 3.0  # W [s]: the averaging window and its hold-out window, each (solver/steady.py)
     fraction: float = 5.0e-4  # a drift below this fraction of a quantity's value passes however small its se
     max_time: float = 30.0  # s: give up (status not_steady) after this
-    min_time: float = 3.0  # s after the end of the belt ramp: the start-up, never averaged nor read as context
+    min_time: float | None = None  # s after the belt's ramp: the start-up, never averaged nor read (None: average)
+
+    @property
+    def start_up(self) -> float:
+        """The start-up after the ramp: min_time, or one averaging window where it is not set."""
+        return self.average if self.min_time is None else self.min_time
     stop: bool = True  # false: run to max_time; the window pair is the final 2W (fixed end time)
     context: float = 15.0  # s of samples before each window (from min_time on) that its se reads
 
@@ -155,7 +160,7 @@ class ConveyorCase(YamlData):
 
     def criteria(self) -> SteadyCriteria:
         s = self.steady
-        return SteadyCriteria(window=s.average, fraction=s.fraction, min_time=self.ramp_end + s.min_time,
+        return SteadyCriteria(window=s.average, fraction=s.fraction, min_time=self.ramp_end + s.start_up,
                               context=s.context)
 
 
@@ -280,7 +285,7 @@ def validate_case(c: ConveyorCase) -> None:
     s = c.steady
     for key in ("average", "max_time"):
         positive(getattr(s, key), f"case.steady.{key}")
-    if s.min_time < 0:
+    if s.min_time is not None and not s.min_time >= 0:
         raise SceneError("case.steady.min_time: must be >= 0")
     if not s.context >= 0.0:
         raise SceneError(f"case.steady.context: {s.context!r} must be >= 0 (s)")

@@ -95,10 +95,10 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisati
             assert d == base[c.id], c.id
         else:
             stem = c.id.rsplit("_r", 1)[0]
+            steady = base[stem]["steady"]
+            start_up = steady.get("min_time", cfgmod.default_min_time(steady))
             extra = {"name": c.id, "start_perturbation": 1e-3, "perturbation_seed": c.realisation,
-                     "steady": {**base[stem]["steady"],
-                                "min_time": base[stem]["steady"].get("min_time", cfgmod.default_min_time())
-                                + 0.25 * c.realisation}}
+                     "steady": {**steady, "min_time": start_up + 0.25 * c.realisation}}
             assert d == {**base[stem], **extra}, c.id
 
 
@@ -561,7 +561,7 @@ def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
 
 def test_staggered_realisations_open_their_windows_later():
     """ensemble.window_stagger: realisation k's steady.min_time is the case's plus k times the
-    stagger (the solver's default where the case sets none); realisation 0 and extra cases keep
+    stagger (the solver's start-up, one window, where the case sets none); realisation 0 and extra cases keep
     the case's, so that realisation 0's run is the unstaggered case's."""
     from solver.conveyor import Steady
     from study.config import case_dict, cases, validate
@@ -574,7 +574,7 @@ def test_staggered_realisations_open_their_windows_later():
         == [2.0, 2.25, 2.5]
     assert case_dict(cfg, by_id["dp2mm_ch1.5_lind_x"])["steady"]["min_time"] == 2.0
     plain = validate({**base, "case": {}, "ensemble": ens})
-    assert case_dict(plain, by_id["dp2mm_ch1.5_lind_r2"])["steady"]["min_time"] == Steady().min_time + 0.5
+    assert case_dict(plain, by_id["dp2mm_ch1.5_lind_r2"])["steady"]["min_time"] == Steady().average + 0.5
     assert "steady" not in case_dict(plain, by_id["dp2mm_ch1.5_lind"])
 
 

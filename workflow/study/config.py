@@ -241,7 +241,7 @@ def case_dict(cfg: dict, case: Case) -> dict:
         stagger = cfg["ensemble"]["window_stagger"]
         if stagger:  # realisation k's window k * stagger later (ensemble.window_stagger)
             steady = d.setdefault("steady", {})
-            steady["min_time"] = steady.get("min_time", default_min_time()) + case.realisation * stagger
+            steady["min_time"] = steady.get("min_time", default_min_time(steady)) + case.realisation * stagger
     for cfg_path, case_path in SOLVER_KEYS.items():  # the metrics read what the runs probed
         node = d
         for key in case_path[:-1]:
@@ -250,10 +250,11 @@ def case_dict(cfg: dict, case: Case) -> dict:
     return d
 
 
-def default_min_time() -> float:
-    """The solver case's steady.min_time where a campaign does not set it."""
+def default_min_time(steady: dict) -> float:
+    """The solver case's start-up where its ``steady`` keys do not set min_time: one window."""
     from solver.conveyor import Steady
-    return Steady().min_time
+    s = Steady()
+    return float(steady.get("average", s.average)) if s.min_time is None else s.min_time
 
 
 def _get(tree: dict, path: tuple):
