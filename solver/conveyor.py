@@ -50,13 +50,13 @@ class Steady:
     fraction: float = 5.0e-4  # a drift below this fraction of a quantity's value passes however small its se
     max_time: float = 30.0  # s: give up (status not_steady) after this
     min_time: float | None = None  # s after the belt's ramp: the start-up, never averaged nor read (None: average)
+    stop: bool = True  # false: run to max_time; the window pair is the final 2W (fixed end time)
+    context: float = 15.0  # s of samples before each window (from min_time on) that its se reads
 
     @property
     def start_up(self) -> float:
         """The start-up after the ramp: min_time, or one averaging window where it is not set."""
         return self.average if self.min_time is None else self.min_time
-    stop: bool = True  # false: run to max_time; the window pair is the final 2W (fixed end time)
-    context: float = 15.0  # s of samples before each window (from min_time on) that its se reads
 
 
 @dataclass

@@ -12,7 +12,7 @@ import time as _time
 
 class ProgressFile:
     """Called after every step (``Runner.run``'s ``on_step``); writes ``path`` at most every
-    ``every`` s of wall time, and once more with ``finish``."""
+    ``every`` s of wall time; ``write`` with the run's status once it has ended."""
 
     def __init__(self, path, case_name: str, monitor, max_time: float, every: float = 5.0):
         self.path, self.name, self.monitor, self.max_time, self.every = os.fspath(path), case_name, monitor, \

@@ -12,7 +12,8 @@ A window pair is an averaging window A = [t - 2W, t - W] and a hold-out window B
 Over each window every component y_i gets a least-squares line: mean m_i with standard error
 s_i, slope b_i with standard error sb_i, both from the series' autocorrelation over the
 ``context`` s before the window (solver.timeseries.window_fits: samples from min_time on; the
-window's own only where fewer than a window's samples precede it). Each component's two drifts, over its allowance:
+window's own only where fewer than a window's samples precede it). Each component's two
+drifts, over its allowance:
 
   hold-out change  d_i = (m_B,i - m_A,i) / max(Z sqrt(s_A,i^2 + s_B,i^2), f |m_A,i|)
   fitted change    e_i = b_A,i W / max(Z sb_A,i W, f |m_A,i|)

@@ -359,7 +359,7 @@ def test_window_errors_are_the_scatter_about_the_line():
 def test_window_errors_unknown_without_a_matching_record():
     """No record, too short a window, or a record whose window mean is not the stored one:
     the errors are NaN (unknown), never zero."""
-    run, ref = series_run(n=9)  # fewer than 2 samples a block
+    run, ref = series_run(n=9)  # fewer than MIN_WINDOW_SAMPLES in the window
     assert np.isnan(float(case_metrics(run, ref).zeta_fs_se))
     run, ref = series_run(depth_noise=0.004)
     run["mean_uniform_depth"] = run["mean_uniform_depth"] * 1.001
