@@ -158,8 +158,8 @@ def read_yaml(path) -> dict:
 
 def override(data: dict, sets) -> dict:
     """``--set KEY=VALUE`` overrides of a case or scene dict, as ``python -m solver front``
-    applies them (``solver.cli.apply_overrides``)."""
-    from solver.cli import apply_overrides
+    applies them (``solver.overrides.apply_overrides``)."""
+    from solver.overrides import apply_overrides
     return apply_overrides(data, list(sets))
 
 

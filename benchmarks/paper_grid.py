@@ -45,7 +45,7 @@ def paper_ch(cfg: dict) -> float:
 def grid_cases(cfg: dict, methods=None, coarsest: int | None = None, paper_ch_only: bool = False) -> dict:
     """{(dp, ch, method): (solver case dict of realisation 0, realisations)} of the grid (only
     ``methods``, the ``coarsest`` dp and the paper Ch where given)."""
-    from study.config import case_dict, cases
+    from study.flows.conveyor import case_dict, cases
     dps = sorted({c.dp for c in cases(cfg) if c.on_grid}, reverse=True)[:coarsest]
     out: dict = {}
     for c in cases(cfg):
@@ -100,7 +100,7 @@ def t_sim_of(specs, method: str, dp: float) -> float:
 
 def start_checks(cfg: dict) -> list[tuple[float, float, str]]:
     """(dp, ch, method) of the campaign's start checks (study.config.start_checks)."""
-    from study.config import START_CHECK_TAG, cases
+    from study.flows.conveyor import START_CHECK_TAG, cases
     return [(c.dp, c.ch, c.shifting) for c in cases(cfg) if c.tag == START_CHECK_TAG]
 
 

@@ -1,4 +1,6 @@
-"""Command line: ``python -m solver run SCENE.yaml -o OUT.nc [--threads N] [--quiet]``."""
+"""Command line: ``python -m solver run SCENE.yaml -o OUT.nc`` (a scene to its end time),
+``python -m solver front CASE.yaml -o OUT.nc`` (the conveyor front to steady state), ``check``
+and ``warm``."""
 from __future__ import annotations
 
 import argparse
@@ -9,29 +11,26 @@ import sys
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="python -m solver", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("run", help="run a scene and write a NetCDF result")
-    r.add_argument("scene", help="scene YAML file")
-    r.add_argument("-o", "--output", required=True, help="NetCDF file to write")
-    r.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
-    r.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    r.add_argument("--allow-diverged", action="store_true",
-                   help="exit 0 when a diverged run was written (campaigns record it)")
     c = sub.add_parser("check", help="validate a scene or a conveyor case file and print its particle count")
     c.add_argument("scene", help="scene YAML file, or a conveyor case file (as for front)")
+    r = sub.add_parser("run", help="run a scene to its end time and write a NetCDF result")
+    r.add_argument("scene", help="scene YAML file (see docs/scenes.md)")
     f = sub.add_parser("front", help="run the conveyor-belt flow-front case to steady state")
     f.add_argument("case", help="case YAML file (see docs/conveyor.md)")
-    f.add_argument("-o", "--output", required=True, help="NetCDF file to write")
-    f.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
-    f.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    f.add_argument("--checkpoint", default=None,
-                   help="checkpoint file (default: OUTPUT.ckpt); resumed from when it matches")
-    f.add_argument("--no-checkpoint", action="store_true", help="never write or read a checkpoint")
-    f.add_argument("--progress", default=None, metavar="JSON",
-                   help="write the run's progress there every few seconds (python -m study status reads it)")
-    f.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a case key, e.g. --set dp=0.002 --set steady.max_time=5")
-    f.add_argument("--allow-diverged", action="store_true",
-                   help="exit 0 when a diverged or unsteady run was written (campaigns record it)")
+    for p, what in ((r, "scene"), (f, "case")):
+        p.add_argument("-o", "--output", required=True, help="NetCDF file to write")
+        p.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
+        p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+        p.add_argument("--checkpoint", default=None,
+                       help="checkpoint file (default: OUTPUT.ckpt); resumed from when it matches")
+        p.add_argument("--no-checkpoint", action="store_true", help="never write or read a checkpoint")
+        p.add_argument("--progress", default=None, metavar="JSON",
+                       help="write the run's progress there every few seconds (python -m study status reads it)")
+        p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help=f"override a {what} key (dotted for nested keys, VALUE read as YAML), "
+                            "e.g. --set dp=0.002")
+        p.add_argument("--allow-diverged", action="store_true",
+                       help="exit 0 when a diverged (or, for front, unsteady) run was written (campaigns record it)")
     w = sub.add_parser("warm", help="compile and cache every numba kernel (before parallel jobs)")
     w.add_argument("cases", nargs="*", default=[],
                    help="front case files whose settings to compile as well (at a coarse dp)")
@@ -45,10 +44,11 @@ def main(argv=None) -> int:
         return _front(args)
     if args.command == "warm":
         return _warm(args)
-    from .scene import SceneError, load_scene
+    from .overrides import apply_overrides
+    from .scene import SceneError, read_yaml, scene_from_dict
     try:
-        scene = load_scene(args.scene)
-    except (SceneError, OSError) as exc:
+        scene = scene_from_dict(apply_overrides(read_yaml(args.scene), getattr(args, "set", [])))
+    except (SceneError, OSError, ValueError) as exc:
         case, case_error = _conveyor_case(args.scene)
         if case is None:
             print(f"error: {case_error or exc}", file=sys.stderr)
@@ -71,8 +71,11 @@ def main(argv=None) -> int:
         return 2
     from .output import to_dataset, write_atomic
     from .run import run_scene
-    res = run_scene(scene, quiet=args.quiet)
+    ckpt = None if args.no_checkpoint else (args.checkpoint or args.output + ".ckpt")
+    res = run_scene(scene, quiet=args.quiet, checkpoint=ckpt, progress=args.progress)
     write_atomic(to_dataset(res), args.output)
+    if ckpt is not None and os.path.exists(ckpt):  # only once the result is on disk
+        os.remove(ckpt)
     msg = f"{scene.name}: {res.status} after {res.steps} steps, {res.wall_time:.1f} s"
     if res.reason:
         msg += f" ({res.reason})"
@@ -111,32 +114,11 @@ def _set_threads(threads) -> bool:
     return True
 
 
-def apply_overrides(data: dict, items) -> dict:
-    """--set a.b=VALUE: VALUE is read as YAML (numbers, lists, null). A named case changed by
-    overrides is renamed to say so, 'NAME [a.b=VALUE, ...]', unless ``name`` is set too."""
-    import yaml
-    items = list(items)
-    keys = [item.partition("=")[0] for item in items]
-    if items and "name" in data and "name" not in keys:
-        data["name"] = f"{data['name']} [{', '.join(items)}]"
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key:
-            raise ValueError(f"--set {item!r}: expected KEY=VALUE")
-        node = data
-        parts = key.split(".")
-        for p in parts[:-1]:
-            node = node.setdefault(p, {})
-            if not isinstance(node, dict):
-                raise ValueError(f"--set {item!r}: {p} is not a mapping")
-        node[parts[-1]] = yaml.safe_load(value)
-    return data
-
-
 def _front(args) -> int:
     from .conveyor import case_from_dict
     from .scene import SceneError, read_yaml
     try:
+        from .overrides import apply_overrides
         case = case_from_dict(apply_overrides(read_yaml(args.case) or {}, args.set))
     except (SceneError, OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -3,12 +3,8 @@ volume-consistency guard, checkpoints, and one NetCDF per run."""
 from __future__ import annotations
 
 import bisect
-import hashlib
 import math
-import os
-import pickle
 import sys
-import tempfile
 from dataclasses import replace
 
 import numba as nb
@@ -17,13 +13,13 @@ import xarray as xr
 
 from . import film_depth, film_fit, steady
 from .build import build_particles
+from .checkpoint import Checkpointer, run_key
 from .conveyor import ConveyorCase, build_scene, lubrication_velocity, scheme_fluid, start_offsets
 from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, last_crossing, toe_position
 from .progress import ProgressFile, chain
 from .run import Runner
 from .simulation import Simulation
-from .sources import source_hash
 
 SERIES = ("toe", "front_position", "front_equivalent", "uniform_depth", "enclosed_area", "mass_area",
           "number_density")
@@ -343,62 +339,7 @@ class FrontMonitor:
 def checkpoint_key(case: ConveyorCase, threads: int) -> str:
     """A checkpoint resumes only the same case, on the same solver sources and thread count
     (another thread count sums in another order: the result would not be bit-for-bit)."""
-    text = f"{case.to_yaml()}\nsolver {source_hash()}\nthreads {threads}"
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-class Checkpointer:
-    """Pickles the runner state every ``interval`` of simulated time, atomically."""
-
-    def __init__(self, path, interval: float, key: str):
-        self.path, self.interval, self.key = os.fspath(path), interval, key
-        self.next = None
-        self.start = None  # (flux ratio, how the start's depth was chosen), saved with the state
-
-    def __call__(self, runner: Runner):
-        if self.next is None:
-            self.next = runner.sim.t + self.interval
-        if runner.sim.t >= self.next - 1e-12:
-            self.save(runner)
-            self.next += self.interval
-
-    def save(self, runner: Runner):
-        state = {"key": self.key, "sim": runner.sim.state(), "res": runner.res,
-                 "next_out": runner.next_out, "next_diag": runner.next_diag,
-                 "next_monitor": runner.next_monitor, "monitors": runner.monitors,
-                 "next_checkpoint": self.next + self.interval, "wall_time": runner.elapsed(),
-                 "start": self.start}
-        folder = os.path.dirname(os.path.abspath(self.path))
-        os.makedirs(folder, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=os.path.basename(self.path) + ".", suffix=".tmp", dir=folder)
-        with os.fdopen(fd, "wb") as fh:
-            pickle.dump(state, fh, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, self.path)
-
-    def load(self) -> dict | None:
-        """The checkpoint's state when it matches this case, solver and thread count; None
-        when there is none, it cannot be read, or it is another's (with a note)."""
-        if not os.path.exists(self.path):
-            return None
-        try:
-            with open(self.path, "rb") as fh:
-                state = pickle.load(fh)
-        except Exception:
-            return None
-        if state.get("key") != self.key:
-            print(f"note: ignoring the checkpoint {self.path}: written for another case, solver "
-                  "version or thread count; starting from t = 0", file=sys.stderr)
-            return None
-        return state
-
-    def restore(self, runner: Runner, state: dict) -> None:
-        """Put a checkpoint's state (from ``load``) into the runner."""
-        runner.sim.restore(state["sim"])
-        runner.res = state["res"]
-        runner.res.wall_time = state["wall_time"]
-        runner.next_out, runner.next_diag = state["next_out"], state["next_diag"]
-        runner.next_monitor, runner.monitors = state["next_monitor"], state["monitors"]
-        self.next = state["next_checkpoint"]
+    return run_key(case.to_yaml(), threads)
 
 
 def start_flux_ratio(case: ConveyorCase, warm_state, quiet: bool = True) -> tuple[float, str]:
@@ -524,7 +465,7 @@ def recorded_case(ds: xr.Dataset, sets=()) -> ConveyorCase:
     replays with today's rule (and its own recorded steady.average as W, and min_time)."""
     import yaml
     from dataclasses import fields
-    from .cli import apply_overrides
+    from .overrides import apply_overrides
     from .conveyor import Steady, case_from_dict
     d = yaml.safe_load(ds.attrs["case_yaml"])
     known = {f.name for f in fields(Steady)}

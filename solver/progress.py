@@ -1,5 +1,5 @@
-"""A running front case's progress as a small JSON file, rewritten atomically every few wall
-seconds: simulated time, the latest window pair's drift ratios, and when the run can end
+"""A running case's progress as a small JSON file, rewritten atomically every few wall seconds:
+simulated time, for a front run the latest window pair's drift ratios, and when the run can end
 (``python -m study status`` reads these files)."""
 from __future__ import annotations
 
@@ -31,13 +31,18 @@ class ProgressFile:
 
     def state(self, runner, status: str) -> dict:
         """The record written: the run's rate is simulated seconds per wall second since this
-        process started; the end lies between the first time a pair may end (or now) and
-        max_time, the wall estimates at that rate."""
-        det = self.monitor.detector
+        process started; a front run's end lies between the first time a pair may end (or now)
+        and max_time, a scene run's (``monitor`` None) at its end time; the wall estimates at
+        that rate."""
         t = float(runner.sim.t)
         rate = (t - self.t_sim0) / max(_time.perf_counter() - self.wall0, 1e-9) if self.t_sim0 is not None else 0.0
-        earliest = max(det.earliest_end if math.isfinite(det.t_first) else det.crit.min_time + 2 * det.crit.window, t)
-        last = det.found or det.last
+        det = self.monitor.detector if self.monitor is not None else None
+        if det is None:
+            earliest, last, found = self.max_time, None, False
+        else:
+            earliest = max(det.earliest_end if math.isfinite(det.t_first) else det.crit.min_time + 2 * det.crit.window,
+                           t)
+            last, found = det.found or det.last, det.found is not None
         ratios = {q: (r if math.isfinite(r) else None) for q, r in last.ratios.items()} if last else {}
 
         def wall_to(t_end):
@@ -45,7 +50,7 @@ class ProgressFile:
 
         return {"case": self.name, "status": status, "t": t, "max_time": self.max_time,
                 "wall_s": float(runner.elapsed()), "sim_s_per_wall_s": rate,
-                "steady": det.found is not None, "t_end_earliest": min(earliest, self.max_time),
+                "steady": found, "detector": det is not None, "t_end_earliest": min(earliest, self.max_time),
                 "wall_left_min_s": wall_to(min(earliest, self.max_time)), "wall_left_max_s": wall_to(self.max_time),
                 "drift_ratios": ratios, "written": _time.time()}
 

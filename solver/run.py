@@ -167,6 +167,30 @@ class Runner:
         return res
 
 
-def run_scene(scene: Scene, quiet: bool = True, sim: Simulation | None = None) -> RunResult:
-    """Integrate to scene.time.end. Divergence ends the run with status 'diverged'."""
-    return Runner(scene, sim).run(quiet)
+CHECKPOINT_WALL_S = 60.0  # a scene run's checkpoint: at most this many wall seconds are lost
+
+
+def run_scene(scene: Scene, quiet: bool = True, sim: Simulation | None = None, checkpoint=None,
+              progress=None) -> RunResult:
+    """Integrate to scene.time.end. Divergence ends the run with status 'diverged'.
+
+    With ``checkpoint`` (a path), the run resumes from a matching checkpoint there
+    (solver/checkpoint.py) and writes one every CHECKPOINT_WALL_S of wall time and at every
+    snapshot interval; the caller removes it once the result is safely written. With
+    ``progress`` (a path), its simulated time and time left are written there every few wall
+    seconds (solver/progress.py)."""
+    from .checkpoint import Checkpointer, run_key
+    from .progress import ProgressFile, chain
+    runner = Runner(scene, sim)
+    ckpt = None
+    if checkpoint is not None:
+        ckpt = Checkpointer(checkpoint, scene.time.output_interval,
+                            run_key(scene.to_yaml(), nb.get_num_threads()), wall_interval=CHECKPOINT_WALL_S)
+        saved = ckpt.load()
+        if saved is not None:
+            ckpt.restore(runner, saved)
+    report = ProgressFile(progress, scene.name, None, scene.time.end) if progress else None
+    res = runner.run(quiet, on_step=chain(ckpt, report))
+    if report is not None:
+        report.write(runner, res.status)
+    return res

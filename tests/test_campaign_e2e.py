@@ -27,14 +27,16 @@ def snakemake(cwd, configfile, *args):
 
 @pytest.fixture(scope="module")
 def campaign(tmp_path_factory):
+    """The miniature campaign run in its own folder from a copy of tests/data/mini.yaml there."""
     work = tmp_path_factory.mktemp("campaign")
-    p = snakemake(work, MINI)
+    (work / "mini.yaml").write_text(MINI.read_text())
+    p = snakemake(work, work / "mini.yaml")
     assert p.returncode == 0, p.stderr[-4000:]
     return work
 
 
 def test_campaign_dataset(campaign):
-    ds = xr.open_dataset(campaign / "results" / "campaign.nc")
+    ds = xr.open_dataset(campaign / "results" / "mini" / "campaign.nc")
     assert set(ds.dims) >= {"dp", "ch", "shifting", "station", "case"}
     for v in ("zeta_f", "zeta_h", "zeta_h_paper", "zeta_fs", "zeta_u", "wall_time", "steps",
               "n_particles", "status"):
@@ -63,14 +65,14 @@ def test_campaign_dataset(campaign):
 
 
 def test_report_has_every_section(campaign):
-    html = (campaign / "reports" / "report.html").read_text()
+    html = (campaign / "reports" / "mini" / "report.html").read_text()
     sections = ("Verdict", "Accuracy and cost", "Summary", "Figures", "Cases", "Convergence",
                 "Stability", "Configuration", "Provenance")
     assert [html.index(f"<h2>{s}</h2>") for s in sections] == sorted(html.index(f"<h2>{s}</h2>") for s in sections)
     assert "dp4mm_ch1.5_skillen_unstable" in html and "diverged" in html
     from study.config import load
-    from study.figures import figures_for
-    assert html.count("data:image/png;base64,") == len(figures_for(load(MINI))) == 11  # Figs. 2-12
+    from study.flows.conveyor import FLOW
+    assert html.count("data:image/png;base64,") == len(FLOW.figures(load(MINI))) == 11  # Figs. 2-12
     assert "Where the plug is" not in html  # a Newtonian campaign: no plug map
     # the forced divergence is counted and named in the stability section and map
     assert "1 diverged, 1 of them stopped by a named detector (1 density deviation)" in html
@@ -83,25 +85,28 @@ def test_report_in_a_real_browser(campaign):
     from study.browser import check_report, find_browser
     if find_browser() is None:
         pytest.skip("no Chromium (Debian: apt-get install chromium); .ci/run installs it")
-    r = check_report(campaign / "reports" / "report.html", screenshot=campaign / "first_screen.png")
+    r = check_report(campaign / "reports" / "mini" / "report.html", screenshot=campaign / "first_screen.png")
     assert r.ok, (r.broken, r.external)
     assert len(r.images) == 11 and r.title == "sph-surge campaign report"
 
 
-def test_figure_settings_do_not_rerun_simulations(campaign, tmp_path):
+def test_figure_settings_do_not_rerun_simulations(campaign):
     cfg = yaml.safe_load(MINI.read_text())
     cfg["figures"]["dpi"] = 61
-    changed = tmp_path / "mini_dpi.yaml"
-    changed.write_text(yaml.safe_dump(cfg))
-    p = snakemake(campaign, changed, "-n", "--quiet", "rules")
+    path = campaign / "mini.yaml"
+    path.write_text(yaml.safe_dump(cfg))  # the campaign file edited in place
+    try:
+        p = snakemake(campaign, path, "-n", "--quiet", "rules")
+    finally:
+        path.write_text(MINI.read_text())
     assert p.returncode == 0, p.stderr
     assert "figures" in p.stdout and "report_html" in p.stdout
     assert "run_case" not in p.stdout and "metrics" not in p.stdout
 
 
 def test_finished_cases_are_not_recomputed(campaign):
-    (campaign / "reports" / "report.html").unlink()
-    p = snakemake(campaign, MINI, "-n", "--quiet", "rules")
+    (campaign / "reports" / "mini" / "report.html").unlink()
+    p = snakemake(campaign, campaign / "mini.yaml", "-n", "--quiet", "rules")
     assert p.returncode == 0, p.stderr
     assert "report_html" in p.stdout and "run_case" not in p.stdout
 
@@ -111,13 +116,14 @@ def test_snakemake_report_takes_the_registered_captions(campaign):
     not the plug map of a Newtonian campaign."""
     import zipfile
     from study.config import load
-    from study.figures import FIGURES, figures_for
-    p = snakemake(campaign, MINI, "--report", "report.zip")
+    from study.figures import FIGURES
+    from study.flows.conveyor import FLOW
+    p = snakemake(campaign, campaign / "mini.yaml", "--report", "report.zip")
     assert p.returncode == 0, p.stderr[-4000:]
     with zipfile.ZipFile(campaign / "report.zip") as z:
         names = z.namelist()
         text = "".join(z.read(n).decode("utf-8", "replace") for n in names if n.endswith((".html", ".js")))
-    drawn = figures_for(load(MINI))
+    drawn = [name for name, _, _ in FLOW.figures(load(MINI))]
     for spec in FIGURES:
-        assert any(n.endswith(f"{spec.name}.png") for n in names) == (spec in drawn), spec.name
+        assert any(n.endswith(f"{spec.name}.png") for n in names) == (spec.name in drawn), spec.name
     assert "Pareto front (no case is both cheaper and more accurate)" in text

@@ -70,7 +70,7 @@ def test_write_atomic_keeps_old_file_on_failure(tmp_path):
 
 def test_overrides_rename_a_named_case():
     """--set shifting=skillen on a case named '...-lind' must not leave the lind title."""
-    from solver.cli import apply_overrides
+    from solver.overrides import apply_overrides
     from solver.conveyor import case_from_dict
     data = apply_overrides({"name": "paper-dp1-ch1.8-lind", "dp": 1e-3, "shifting": "lind"},
                            ["shifting=skillen", "steady.max_time=5"])

@@ -15,7 +15,9 @@ import yaml
 
 from solver.conveyor import case_from_dict
 import study.config as cfgmod
-from study.config import SOLVER_KEYS, load_schema
+from study.flows import conveyor
+from study.flows.conveyor import SCHEMA, SOLVER_KEYS
+from study.schema import load_schema
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_CASE = case_from_dict({"dp": 0.001})
@@ -32,7 +34,7 @@ def _plain(v):
 
 
 def _schema_default(path):
-    node = load_schema()
+    node = load_schema(SCHEMA)
     for key in path:
         node = node["properties"][key]
     return node["default"]
@@ -139,10 +141,10 @@ def test_a_campaign_with_an_empty_case_runs_the_default_campaigns_scheme():
     cfg = cfgmod.load(ROOT / "config" / "config.yaml")
     raw = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     bare = cfgmod.validate({"case": {}, "grid": raw["grid"]})
-    assert [c.id for c in cfgmod.cases(bare)] == [c.id for c in cfgmod.cases(cfg)]
-    for case in cfgmod.cases(cfg):
-        ours = case_from_dict(cfgmod.case_dict(cfg, case)).to_dict()
-        theirs = case_from_dict(cfgmod.case_dict(bare, case)).to_dict()
+    assert [c.id for c in conveyor.cases(bare)] == [c.id for c in conveyor.cases(cfg)]
+    for case in conveyor.cases(cfg):
+        ours = case_from_dict(conveyor.case_dict(cfg, case)).to_dict()
+        theirs = case_from_dict(conveyor.case_dict(bare, case)).to_dict()
         differ = {k for k in ours.keys() | theirs.keys() if ours.get(k) != theirs.get(k)}
         assert differ <= {"steady"}, (case.id, differ)
         assert ours["scheme"] == "surge" and ours["numerics"] == theirs["numerics"]

@@ -11,11 +11,20 @@ import xarray as xr
 import yaml
 
 from study.config import ConfigError, validate
-from study.flowconfig import cases, scene_dict
-from study.flows import film, scores, slump
+from study.flows import scores
+from study.references import film, slump
+from study.registry import flow_of
 
 ROOT = Path(__file__).resolve().parent.parent
 G = 9.81
+
+
+def cases(cfg):
+    return flow_of(cfg).cases(cfg)
+
+
+def scene_dict(cfg, case):
+    return flow_of(cfg).case_dict(cfg, case)
 
 
 def config(name):
@@ -164,7 +173,7 @@ def test_a_front_that_stops_is_found_stopped_and_one_that_creeps_is_not():
 def test_a_user_front_reference_scores_a_symmetric_release(tmp_path, shift):
     """The similarity current as a run, its front written as a user's CSV (raised by ``shift``):
     the user flow's front error is the shift (to 0.4 %, the front's dp / 2 granularity)."""
-    from study.flows.user import read_front
+    from study.references.user import read_front
     H0, L0, nu, dp = 0.05, 0.1, 4e-3, 5e-4
     times = np.arange(0.25, 5.01, 0.25)
     run = fake_run(times, [similarity_particles(t, H0 * L0, nu, dp) for t in times], dp)
@@ -207,12 +216,12 @@ def test_a_film_campaign_runs_end_to_end_and_reports_its_answer(tmp_path):
     p = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--configfile",
                         str(path), "--cores", "2"], cwd=tmp_path, capture_output=True, text=True)
     assert p.returncode == 0, p.stderr[-4000:]
-    ds = xr.load_dataset(tmp_path / "results" / "campaign.nc")
+    ds = xr.load_dataset(tmp_path / "results" / "film" / "campaign.nc")
     assert list(ds["case"].values) == ["dp4mm_ch1.5_skillen_surge_newtonian", "dp2.5mm_ch1.5_skillen_surge_newtonian",
                                        "dp4mm_ch1.5_skillen_spec_newtonian", "dp2.5mm_ch1.5_skillen_spec_newtonian"]
     assert np.all(ds["status"].values == "completed")
     assert np.all(np.isfinite(ds["profile_error"].values)) and np.all(ds["profile_error"].values < 0.1)
-    html = (tmp_path / "reports" / "report.html").read_text()
+    html = (tmp_path / "reports" / "film" / "report.html").read_text()
     for section in ("Answer", "Accuracy and cost", "Convergence", "Stability", "Run time against error"):
         assert section in html
     assert "Verdict" not in html and "Where the plug is" not in html
@@ -223,8 +232,6 @@ def test_a_diverged_run_is_recorded_with_its_reason_and_no_errors(tmp_path):
     """A flow run that diverged is scored with no errors; the campaign dataset, the figures and the
     report still come out, the report's stability map naming its reason."""
     from solver.output import write_atomic
-    from study.flowcampaign import reduce, score
-    from study.flowreport import render, write_figures
     cfg = config("film")
     cfg["grid"].update(dp=[2e-3, 1e-3], scheme=["surge"])
     cfg = validate(cfg)
@@ -235,10 +242,10 @@ def test_a_diverged_run_is_recorded_with_its_reason_and_no_errors(tmp_path):
     bad.attrs.update(status="diverged", reason="density deviation 0.2 exceeds 0.1")
     for c, run in zip(cases(cfg), (bad, good)):
         run.attrs.update(wall_time_s=1.0, steps=10, n_particles=z.size)
-        write_atomic(score(cfg, c, run), tmp_path / c.id / "metrics.nc")
-    ds = reduce(cfg, tmp_path)
+        write_atomic(flow_of(cfg).score(cfg, c.id, run), tmp_path / c.id / "metrics.nc")
+    ds = flow_of(cfg).reduce(cfg, tmp_path)
     assert list(ds["status"].values) == ["diverged", "completed"]
     assert np.isnan(ds["profile_error"].values[0]) and ds["profile_error"].values[1] < 1e-9
-    write_figures(cfg, ds, tmp_path / "figures")
-    html = render(cfg, ds, tmp_path / "figures", "")
+    flow_of(cfg).write_figures(cfg, ds, tmp_path / "figures")
+    html = flow_of(cfg).render(cfg, ds, tmp_path / "figures")
     assert "1 of 2 runs did not complete" in html and "diverged: density deviation 0.2 exceeds 0.1" in html

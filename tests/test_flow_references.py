@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from solver import exact
-from study.flows import film, slump, user
+from study.references import film, slump, user
 
 RHO, G = 1000.0, 9.81
 

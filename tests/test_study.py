@@ -12,7 +12,9 @@ import pytest
 import xarray as xr
 import yaml
 
-from study import config as cfgmod
+from study import config as campaign_config
+from study import schema
+from study.flows import conveyor as cfgmod
 from study.grid import CASE_ID, case_id, expand, fmt
 from study.metrics import case_metrics, rms_difference, zeta_f_error
 from study.reference import read_velocity_csv, theory
@@ -53,15 +55,15 @@ def test_grid_product_paper_and_extra_cases():
 def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():
     c = load("config.yaml")
     c["grid"] = {"dp": [0.003], "ch": [1.0, 1.8], "shifting": ["lind"]}
-    with pytest.raises(cfgmod.ConfigError) as exc:
-        cfgmod.validate(c)
+    with pytest.raises(schema.ConfigError) as exc:
+        campaign_config.validate(c)
     msg = str(exc.value)
     assert "dp3mm_ch1_lind" in msg and "numerics.shifting.method: lind needs ch >= 1.1" in msg
     assert "8 neighbours" in msg and "skillen or none" in msg
 
 
 def test_configs_validate_and_expand():
-    default = cfgmod.validate(load("config.yaml"))
+    default = campaign_config.validate(load("config.yaml"))
     cs = cfgmod.cases(default)
     # Ch 1.8 x both methods x 3 dp; skillen at Ch 1.3 and 2.2 on the two coarser; then the start checks
     assert len(cs) == 12 and [c.id for c in cs[10:]] == ["dp1mm_ch1.8_skillen_paper-start",
@@ -71,7 +73,7 @@ def test_configs_validate_and_expand():
     dps = sorted({c.dp for c in cs})
     assert dps[0] == 0.001 and dps[1] / dps[0] == pytest.approx(dps[2] / dps[1]) == 1.5  # constant ratio
     assert {c.shifting for c in cs if c.dp == 0.001 and c.ch == 1.8} == {"skillen", "lind"}
-    paper = cfgmod.validate(load("paper.yaml"))
+    paper = campaign_config.validate(load("paper.yaml"))
     cs = cfgmod.configured_cases(paper)
     assert len(cs) == 18 and len(cfgmod.cases(paper)) == 20
     assert {c.dp for c in cs} == {0.001, 0.0005, 0.00025}
@@ -83,8 +85,8 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisati
     """config/accuracy.yaml: realisation 0 of each case has the default campaign's case file
     exactly (so that a finished default run is kept), the others its perturbed starts with
     their windows staggered by 0.25 s (``ensemble.window_stagger``)."""
-    default = cfgmod.validate(load("config.yaml"))
-    acc = cfgmod.validate(load("accuracy.yaml"))
+    default = campaign_config.validate(load("config.yaml"))
+    acc = campaign_config.validate(load("accuracy.yaml"))
     cs = cfgmod.configured_cases(acc)
     assert len(cs) == 32 and {c.realisation for c in cs} == set(range(16))
     assert {(c.dp, c.ch) for c in cs} == {(0.001, 1.8)} and {c.shifting for c in cs} == {"skillen", "lind"}
@@ -120,16 +122,16 @@ def test_accuracy_config_is_the_default_campaigns_1mm_cases_in_sixteen_realisati
 def test_schema_errors_name_the_key(change, key):
     c = load("config.yaml")
     c.update(change)
-    with pytest.raises(cfgmod.ConfigError) as exc:
-        cfgmod.validate(c)
+    with pytest.raises(schema.ConfigError) as exc:
+        campaign_config.validate(c)
     assert f"config key {key}:" in str(exc.value)
     if key.endswith("case"):  # a grid key in a case mapping: named, not the schema's "not" dump
         assert "which each case takes from the grid" in str(exc.value) and "anyOf" not in str(exc.value)
 
 
 def test_a_campaign_without_case_keys_is_told_what_case_holds():
-    with pytest.raises(cfgmod.ConfigError, match=r"config key \(top level\): 'case' is required.*case: \{\}"):
-        cfgmod.validate({"grid": {"dp": [0.002], "ch": [1.8], "shifting": ["lind"]}})
+    with pytest.raises(schema.ConfigError, match=r"config key \(top level\): 'case' is required.*case: \{\}"):
+        campaign_config.validate({"grid": {"dp": [0.002], "ch": [1.8], "shifting": ["lind"]}})
 
 
 def test_exponent_notation_reads_as_a_number():
@@ -139,13 +141,13 @@ def test_exponent_notation_reads_as_a_number():
             "       exclude: [{dp: 3e-3, ch: 1.3}]}\nextra_cases: [{dp: 2e-3, ch: 1.8, shifting: skillen}]\n")
     raw = yaml.safe_load(text)
     assert raw["grid"]["dp"] == ["3e-3", 0.0025]  # what the loader gives: 3e-3 a string
-    cfg = cfgmod.validate(raw)
+    cfg = campaign_config.validate(raw)
     assert cfg["grid"]["dp"] == [0.003, 0.0025]
     assert [c.id for c in cfgmod.cases(cfg)] == [
         "dp3mm_ch1.8_lind", "dp2.5mm_ch1.8_lind", "dp2.5mm_ch1.3_lind", "dp2mm_ch1.8_skillen"]
     raw["grid"]["dp"] = ["3 mm"]  # not a number: still refused, naming the key
-    with pytest.raises(cfgmod.ConfigError, match="config key grid.dp.0:"):
-        cfgmod.validate(raw)
+    with pytest.raises(schema.ConfigError, match="config key grid.dp.0:"):
+        campaign_config.validate(raw)
 
 
 def test_command_line_strings_read_as_the_schema_types():
@@ -153,26 +155,26 @@ def test_command_line_strings_read_as_the_schema_types():
     reads integers and booleans where the schema expects them, and refuses what is neither."""
     c = load("config.yaml")
     c.update(ensemble={"realisations": "4", "perturbation": "1e-3"}, figures={"dpi": "90"})
-    cfg = cfgmod.validate(c)
+    cfg = campaign_config.validate(c)
     assert cfg["ensemble"] == {"realisations": 4, "perturbation": 0.001, "overrides": [], "window_stagger": 0.0}
     assert cfg["figures"]["dpi"] == 90 and len(cfgmod.cases(cfg)) == 40 + 2  # and the two start checks
-    schema = cfgmod.load_schema()
-    assert cfgmod.coerce_scalars({"warm_start": "True"}, schema) == {"warm_start": True}
+    conveyor_schema = schema.load_schema(cfgmod.SCHEMA)
+    assert schema.coerce_scalars({"warm_start": "True"}, conveyor_schema) == {"warm_start": True}
     for key, bad in (("realisations", "4.5"), ("realisations", "four")):
         c["ensemble"] = {key: bad}
-        with pytest.raises(cfgmod.ConfigError, match=f"config key ensemble.{key}:"):
-            cfgmod.validate(c)
+        with pytest.raises(schema.ConfigError, match=f"config key ensemble.{key}:"):
+            campaign_config.validate(c)
     c["ensemble"] = {}
     c["warm_start"] = "yes"
-    with pytest.raises(cfgmod.ConfigError, match="config key warm_start:"):
-        cfgmod.validate(c)
+    with pytest.raises(schema.ConfigError, match="config key warm_start:"):
+        campaign_config.validate(c)
 
 
 def test_solver_level_errors_are_caught_before_jobs():
     c = load("config.yaml")
     c["case"]["steady"]["average"] = 0.1
-    with pytest.raises(cfgmod.ConfigError, match="case.steady.average"):
-        cfgmod.validate(c)
+    with pytest.raises(schema.ConfigError, match="case.steady.average"):
+        campaign_config.validate(c)
 
 
 def test_case_overrides_apply_to_the_matching_cases_only_in_order():
@@ -183,7 +185,7 @@ def test_case_overrides_apply_to_the_matching_cases_only_in_order():
                            {"where": {"dp": 1e-3, "shifting": "lind"}, "case": {"steady": {"min_time": 3.0}}}]
     c["extra_cases"] = [{"dp": 1e-3, "ch": 1.3, "shifting": "skillen", "tag": "own",
                          "overrides": {"steady": {"min_time": 2.5}}}]
-    cfg = cfgmod.validate(c)
+    cfg = campaign_config.validate(c)
     min_time = {x.id: cfgmod.case_dict(cfg, x)["steady"].get("min_time") for x in cfgmod.cases(cfg)}
     assert min_time == {"dp2mm_ch1.8_skillen": None, "dp2mm_ch1.8_lind": None,
                         "dp1mm_ch1.8_skillen": 2.0, "dp1mm_ch1.8_lind": 3.0, "dp1mm_ch1.3_skillen_own": 2.5}
@@ -201,8 +203,8 @@ def test_case_overrides_apply_to_the_matching_cases_only_in_order():
 def test_bad_case_overrides_are_refused_naming_the_key(entry, message):
     c = load("config.yaml")
     c["case_overrides"] = [entry]
-    with pytest.raises(cfgmod.ConfigError) as exc:
-        cfgmod.validate(c)
+    with pytest.raises(schema.ConfigError) as exc:
+        campaign_config.validate(c)
     assert message in str(exc.value)
 
 
@@ -427,7 +429,8 @@ def test_snakemake_rejects_bad_config(tmp_path):
 
 @pytest.mark.slow
 def test_warm_start_chains_each_case_to_the_next_coarser_dp(tmp_path):
-    from study.config import case_dict, cases, validate, warm_source
+    from study.config import validate
+    from study.flows.conveyor import case_dict, cases, warm_source
     cfg = validate({"case": {}, "grid": {"dp": [0.003, 0.002, 0.0025], "ch": [1.5], "shifting": ["lind"]},
                     "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}],
                     "warm_start": True})
@@ -437,7 +440,7 @@ def test_warm_start_chains_each_case_to_the_next_coarser_dp(tmp_path):
     assert warm_source(cfg, by_id["dp2mm_ch1.5_lind"]).id == "dp2.5mm_ch1.5_lind"
     assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_x"]) is None  # extra cases start cold
     d = case_dict(cfg, by_id["dp2mm_ch1.5_lind"])
-    assert d["start"] == "warm" and d["warm_from"] == "results/cases/dp2.5mm_ch1.5_lind/run.nc"
+    assert d["start"] == "warm" and d["warm_from"] == "results/campaign/cases/dp2.5mm_ch1.5_lind/run.nc"
     assert "warm_from" not in case_dict({**cfg, "warm_start": False}, by_id["dp2mm_ch1.5_lind"])
     # snakemake orders the runs: the dry run lists the coarse run before the fine one
     configfile = tmp_path / "warm.yaml"
@@ -448,8 +451,8 @@ def test_warm_start_chains_each_case_to_the_next_coarser_dp(tmp_path):
                        cwd=tmp_path, capture_output=True, text=True)
     assert p.returncode == 0, p.stderr + p.stdout
     out = p.stdout
-    coarse = out.index("front results/cases/dp3mm_ch1.5_lind/case.yaml")
-    fine = out.index("front results/cases/dp2mm_ch1.5_lind/case.yaml")
+    coarse = out.index("front results/warm/cases/dp3mm_ch1.5_lind/case.yaml")
+    fine = out.index("front results/warm/cases/dp2mm_ch1.5_lind/case.yaml")
     assert coarse < fine
 
 
@@ -538,7 +541,8 @@ def test_an_ensemble_runs_every_grid_case_in_perturbed_realisations():
     """Realisation 0 is the case as configured (the same solver file as without an ensemble,
     so its finished run is kept); realisation k moves the start by the configured amplitude
     with seed k; extra cases run once; a warm start chains within a realisation."""
-    from study.config import case_dict, cases, validate, warm_source
+    from study.config import validate
+    from study.flows.conveyor import case_dict, cases, warm_source
     base = {"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind"]},
             "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}], "start_check": False}
     single = validate(base)
@@ -564,7 +568,8 @@ def test_staggered_realisations_open_their_windows_later():
     stagger (the solver's start-up, one window, where the case sets none); realisation 0 and extra cases keep
     the case's, so that realisation 0's run is the unstaggered case's."""
     from solver.conveyor import Steady
-    from study.config import case_dict, cases, validate
+    from study.config import validate
+    from study.flows.conveyor import case_dict, cases
     base = {"grid": {"dp": [0.002], "ch": [1.5], "shifting": ["lind"]},
             "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}]}
     ens = {"realisations": 3, "window_stagger": 0.25}
@@ -582,7 +587,9 @@ def test_ensemble_overrides_set_the_realisations_of_some_grid_points():
     """ensemble.overrides: the last matching entry sets a grid point's count (dp compared as a
     float); extra cases still run once; a warm start takes the coarser point's same
     realisation, or its realisation 0 where that point ran fewer; a bad entry is named."""
-    from study.config import ConfigError, cases, validate, warm_source
+    from study.config import validate
+    from study.flows.conveyor import cases, warm_source
+    from study.schema import ConfigError
     base = {"case": {}, "grid": {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind", "skillen"]},
             "extra_cases": [{"dp": 0.002, "ch": 1.5, "shifting": "lind", "tag": "x"}], "warm_start": True,
             "start_check": False}
@@ -632,7 +639,7 @@ def test_each_run_is_scored_against_the_theory_of_its_own_physical_case(tmp_path
         "case": {"scheme": "spec"}, "grid": {"dp": [3e-3], "ch": [1.5], "shifting": ["skillen"]},
         "extra_cases": [{"dp": 3e-3, "ch": 1.5, "shifting": "skillen", "tag": "slope10",
                          "overrides": {"slope_deg": 10.0}}]}))
-    cfg = cfgmod.load(cfg_path)
+    cfg = campaign_config.load(cfg_path)
     x = np.round(np.arange(0, 14.0001, 0.1), 10)
     z = np.round(np.arange(0, 1.3001, 0.025), 10)
     st = np.array([0.76, 1.5, 9.7])

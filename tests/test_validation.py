@@ -124,7 +124,7 @@ def test_a_users_csv_reference_scores_a_run_and_refuses_a_shifted_one(tmp_path):
     reference raised by 5 % it is not (measured 4.8 %)."""
     from solver.output import to_dataset
     from study.flows.scores import user_scores
-    from study.flows.user import read_velocity_profiles
+    from study.references.user import read_velocity_profiles
     scene = example_scene("poiseuille")
     res = run_scene(scene)
     assert res.status == "completed", res.reason
@@ -146,9 +146,9 @@ def test_a_users_csv_reference_scores_a_run_and_refuses_a_shifted_one(tmp_path):
 
 def test_film_start_up_follows_the_exact_series():
     """examples/film.yaml starts from rest: at every output time to 0.3 s (3.4 viscous times
-    H^2 / nu) its velocity is within 1 % of u_max of the start-up series of study.flows.film,
+    H^2 / nu) its velocity is within 1 % of u_max of the start-up series of study.references.film,
     rms over the fluid particles (measured 0.51-0.79 %)."""
-    from study.flows import film
+    from study.references import film
     scene = example_scene("film")
     res = run_scene(scene)
     assert res.status == "completed", res.reason

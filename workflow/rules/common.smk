@@ -1,28 +1,31 @@
-# Config validation (schema, then what a schema cannot check) before any job starts,
-# and the case grid.
+# The campaign, read and checked before any job starts (its flow's schema, then what a schema
+# cannot check), its flow (study.registry: every flow-specific choice below is the flow's), and
+# where it writes (study.layout).
+import shlex
+import sys
+
 import yaml
-from study.config import validate as validate_campaign, cases as campaign_cases, case_dict, run_path, warm_source
+from study.config import validate as validate_campaign
 from study.grid import CASE_ID
+from study.layout import report_path, results_dir, run_path
+from study.registry import flow_of
+from study.schema import ConfigError
 
-config = validate_campaign(config)  # the schema (with its defaults), then what it cannot check
-FLOW = config.get("flow", "conveyor")  # conveyor, or a flow of study.flowconfig
-if FLOW != "conveyor":
-    from study import flowconfig
-    from study.flowconfig import CASE_ID
-
-    campaign_cases = flowconfig.cases
-    case_dict = flowconfig.scene_dict
-CASES = campaign_cases(config)
+CAMPAIGN_FILE = os.path.abspath(workflow.overwrite_configfiles[-1] if workflow.overwrite_configfiles
+                                else DEFAULT_CAMPAIGN)
+config = validate_campaign(config, source=CAMPAIGN_FILE)
+FLOW = flow_of(config)
+CASES = FLOW.cases(config)
 CASE_IDS = [c.id for c in CASES]
 CASE_BY_ID = {c.id: c for c in CASES}
 RES = config["resources"]
+R = results_dir(config)  # results/<name>
+REPORT = report_path(config)
+PY = shlex.quote(sys.executable)  # the interpreter that runs Snakemake runs the rules
 
 
 def _write_if_changed(path, text):
-    """The merged, validated config for our CLIs; rewritten only when it changes. Rules take
-    it as a param, not an input, and list the settings they use as params, so a change to
-    figure settings does not rerun simulations."""
-    import os
+    """Write ``text`` to ``path`` (atomically) only when it changes."""
     old = open(path).read() if os.path.exists(path) else None
     if old != text:
         os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -31,57 +34,42 @@ def _write_if_changed(path, text):
         os.replace(f"{path}.tmp", path)
 
 
-CONFIG_FILE = "results/campaign_config.yaml"
+# One campaign file a name: a second file with the same name would share its runs and report.
+_SOURCE = f"{R}/campaign_source.txt"
+if os.path.exists(_SOURCE) and open(_SOURCE).read().strip() != CAMPAIGN_FILE:
+    raise ConfigError(f"config key name: {config['name']!r} is the name of the campaign "
+                      f"{open(_SOURCE).read().strip()}, whose results are in {R}/; give {CAMPAIGN_FILE} "
+                      "another name (name: ...), or delete that folder")
+_write_if_changed(_SOURCE, CAMPAIGN_FILE + "\n")
+
+# The merged, validated config for our CLIs; rewritten only when it changes. Rules take it as
+# a param, not an input, and list the settings they use as params, so a change to figure
+# settings does not rerun simulations.
+CONFIG_FILE = f"{R}/campaign_config.yaml"
 _write_if_changed(CONFIG_FILE, yaml.safe_dump(config, sort_keys=False))
 
 from solver.sources import files_hash, source_hash
 
 SOLVER_HASH = source_hash()  # a param of every run: a changed solver reruns them
-
-import study.metrics, study.reference
-
-# a param of the metrics: new metric code rescores
-if FLOW == "conveyor":
-    METRICS_HASH = files_hash([study.metrics.__file__, study.reference.__file__], names=False)
-    METRIC_KEYS = ("reference", "metrics")
-else:
-    import pathlib
-
-    import study.flowcampaign, study.flowconfig, study.flows
-
-    METRICS_HASH = files_hash([study.flowcampaign.__file__, study.flowconfig.__file__]
-                              + sorted(pathlib.Path(study.flows.__file__).parent.glob("*.py")), names=False)
-    METRIC_KEYS = ("scene", "fluids", "metrics")
+METRICS_HASH = files_hash(FLOW.metric_sources(), names=False)  # a param of the metrics: new code rescores
+METRIC_KEYS = FLOW.metric_keys
 
 wildcard_constraints:
     case=CASE_ID,
 
 
 def case_yaml(wildcards):
-    """The solver case of one campaign case: a param, so only its own settings rerun it."""
-    return yaml.safe_dump(case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=True)
+    """The solver file of one case: a param, so only its own settings rerun it."""
+    return yaml.safe_dump(FLOW.case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=True)
 
 
 def warm_input(wildcards):
-    """The coarser case's run a warm-started case starts from (none without warm_start)."""
-    if FLOW != "conveyor":
-        return []
-    src = warm_source(config, CASE_BY_ID[wildcards.case])
-    return [run_path(src)] if src is not None else []
+    """The run a warm-started case starts from (none for a cold start)."""
+    src = FLOW.warm_source(config, CASE_BY_ID[wildcards.case])
+    return [run_path(config, src.id)] if src is not None else []
 
 
 def run_priority(wildcards):
     """Finer cases first (cost ~ dp^-3): the longest runs start at once, so that the cores
     finish together instead of one long run starting last."""
     return round(1e-9 / CASE_BY_ID[wildcards.case].dp ** 3, 3)
-
-
-# the solver command of a run: the conveyor front to steady state, or a flow's scene to its end
-if FLOW == "conveyor":
-    RUN_COMMAND = ("NUMBA_NUM_THREADS={threads} python -m solver front {input.case} -o {output} "
-                   "--threads {threads} --quiet --allow-diverged "
-                   "--checkpoint results/checkpoints/{wildcards.case}.ckpt "
-                   "--progress results/progress/{wildcards.case}.json 2> {log}")
-else:
-    RUN_COMMAND = ("NUMBA_NUM_THREADS={threads} python -m solver run {input.case} -o {output} "
-                   "--threads {threads} --quiet --allow-diverged 2> {log}")

@@ -1,37 +1,39 @@
 rule compile_kernels:
     input:
-        expand("results/cases/{case}/case.yaml", case=CASE_IDS),  # their settings are compiled too
+        expand(f"{R}/cases/{{case}}/case.yaml", case=CASE_IDS),  # their settings are compiled too
     output:
-        touch("results/.kernels_compiled"),
+        touch(f"{R}/.kernels_compiled"),
     log:
-        "results/logs/compile_kernels.log",
+        f"{R}/logs/compile_kernels.log",
     params:
         solver=SOLVER_HASH,  # the kernels are cached per solver hash: a new solver compiles anew
     shell:
-        "python -m solver warm {input} 2> {log}"
+        f"{PY} -m solver warm {{input}} 2> {{log}}"
 
 
 rule case_file:
     output:
-        "results/cases/{case}/case.yaml",
+        f"{R}/cases/{{case}}/case.yaml",
     log:
-        "results/logs/case_file_{case}.log",
+        f"{R}/logs/case_file_{{case}}.log",
     params:
         text=case_yaml,  # a change of this case's settings rewrites it (and reruns the case)
         config=CONFIG_FILE,
     shell:
-        "python -m study case-file {params.config} {wildcards.case} -o {output} 2> {log}"
+        f"{PY} -m study case-file {{params.config}} {{wildcards.case}} -o {{output}} 2> {{log}}"
 
 
+# A run resumes from its checkpoint (outside output:, which Snakemake deletes before a rerun)
+# and shows its progress to python -m study status.
 rule run_case:
     input:
-        case="results/cases/{case}/case.yaml",
-        kernels=ancient("results/.kernels_compiled"),  # compiled first; a recompile reruns nothing
+        case=f"{R}/cases/{{case}}/case.yaml",
+        kernels=ancient(f"{R}/.kernels_compiled"),  # compiled first; a recompile reruns nothing
         warm=warm_input,
     output:
-        "results/cases/{case}/run.nc",
+        f"{R}/cases/{{case}}/run.nc",
     log:
-        "results/logs/run_{case}.log",
+        f"{R}/logs/run_{{case}}.log",
     params:
         solver=SOLVER_HASH,
     priority: run_priority
@@ -40,4 +42,6 @@ rule run_case:
         runtime=RES["runtime_min"],
         mem_mb=RES["mem_mb"],
     shell:
-        RUN_COMMAND
+        (f"NUMBA_NUM_THREADS={{threads}} {PY} -m solver {FLOW.solver} {{input.case}} -o {{output}} "
+         f"--threads {{threads}} --quiet --allow-diverged --checkpoint {R}/checkpoints/{{wildcards.case}}.ckpt "
+         f"--progress {R}/progress/{{wildcards.case}}.json 2> {{log}}")

@@ -21,6 +21,13 @@ import numpy as np
 
 from solver.roots import bisect
 
+# an observed order below this is no asymptotic convergence: no dp is projected from it
+MIN_ORDER = 0.5
+# an observed order above this is unreliable: three values whose differences happen to shrink
+# fast, not convergence; r21^p so large would shrink the GCI band to nothing. Nothing is
+# extrapolated from it (no limit, no band, no dp projected)
+MAX_ORDER = 4.0
+
 
 @dataclass
 class GCIResult:

@@ -15,7 +15,7 @@ import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
-from .verdict import MAX_ORDER  # noqa: E402
+from .convergence import MAX_ORDER  # noqa: E402
 
 
 # Okabe-Ito palette
@@ -36,14 +36,14 @@ class Settings:
 @dataclass(frozen=True)
 class FigureSpec:
     """One figure of the report: its file name, title, caption and drawing function.
-    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note; ``when``,
-    given the validated campaign config, says whether the campaign draws it (None: always)."""
+    ``caption`` may name {ch} (the profile Ch); ``hollow`` appends the marker note; a
+    ``yield_stress_only`` figure is drawn only by a campaign with a yield-stress case."""
     name: str
     title: str
     caption: str
     draw: Callable[[xr.Dataset, Settings], object]
     hollow: bool = False
-    when: Callable[[dict], bool] | None = None
+    yield_stress_only: bool = False
 
     def full_caption(self, profile_ch: float) -> str:
         return self.caption.format(ch=profile_ch) + (HOLLOW if self.hollow else "")
@@ -277,13 +277,6 @@ def fig_plug_map(ds, ch):
     return _front_panels(ds, ch, draw)
 
 
-def has_yield_stress(config: dict) -> bool:
-    """Whether any case of the validated campaign config, grid or extra, runs a yield-stress
-    (Herschel-Bulkley) fluid: the plug map's condition."""
-    from .config import cases, solver_case
-    return any(not solver_case(config, c).newtonian for c in cases(config))
-
-
 def fig_shifting_comparison(ds, var, ch, station_panels=False):
     ch = float(ds["ch"].sel(ch=ch, method="nearest"))
     sub = ds.sel(ch=ch)
@@ -468,15 +461,15 @@ FIGURES = (
                "at the finest dp and Ch = {ch:g}, yielded (viscosity below the cap max_viscosity) "
                "or unyielded (at the cap: the plug). Not in the paper; drawn only for a campaign "
                "with a Herschel-Bulkley case.",
-               lambda ds, st: fig_plug_map(ds, st.profile_ch), when=has_yield_stress),
+               lambda ds, st: fig_plug_map(ds, st.profile_ch), yield_stress_only=True),
 )
 FIGURE_NAMES = tuple(f.name for f in FIGURES)
 
 
-def figures_for(config: dict) -> tuple[FigureSpec, ...]:
-    """The registered figures that the campaign of ``config`` (validated: study.config.validate)
-    draws: the rules' outputs, Snakemake's report and the HTML report take these."""
-    return tuple(spec for spec in FIGURES if spec.when is None or spec.when(config))
+def figures_for(yield_stress: bool) -> tuple[FigureSpec, ...]:
+    """The registered figures that a campaign draws, with or without a yield-stress case: the
+    rules' outputs, Snakemake's report and the HTML report take these."""
+    return tuple(spec for spec in FIGURES if yield_stress or not spec.yield_stress_only)
 
 
 def write_all(ds: xr.Dataset, outdir, settings: Settings, fmt: str = "png", dpi: int = 120,

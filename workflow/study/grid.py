@@ -1,10 +1,12 @@
-"""Case grid: dp x Ch x shifting from the config, with canonical, float-safe case ids."""
+"""The case of every campaign, and the conveyor's grid dp x Ch x shifting, with canonical,
+float-safe case ids."""
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-CASE_ID = r"dp[0-9]+(?:\.[0-9]+)?mm_ch[0-9]+(?:\.[0-9]+)?_(?:none|skillen|lind)(?:_[a-z0-9-]+)?"
+# every flow's case ids: dp, Ch and shifting, then the scheme, fluid, physical axes or tag
+CASE_ID = r"dp[0-9]+(?:\.[0-9]+)?mm_ch[0-9]+(?:\.[0-9]+)?_(?:none|skillen|lind)(?:_[A-Za-z0-9.-]+)*"
 
 
 def fmt(x: float, digits: int = 6) -> str:
@@ -14,26 +16,43 @@ def fmt(x: float, digits: int = 6) -> str:
     return "0" if s in ("-0", "") else s
 
 
-def case_id(dp: float, ch: float, shifting: str, tag: str | None = None, realisation: int = 0) -> str:
-    """E.g. dp1mm_ch1.8_lind; dp in mm; realisation k > 0 of a grid case ends in _rk."""
-    cid = f"dp{fmt(dp * 1000.0)}mm_ch{fmt(ch)}_{shifting}"
+def axis_label(key: str) -> str:
+    """A physical axis's name in a case id: the last part of its dotted key."""
+    return key.rsplit(".", 1)[-1]
+
+
+def case_id(dp: float, ch: float, shifting: str, tag: str | None = None, realisation: int = 0,
+            scheme: str | None = None, fluid: str | None = None, axes: tuple = ()) -> str:
+    """E.g. dp1mm_ch1.8_lind, dp2mm_ch1.5_skillen_surge_newtonian, dp1mm_ch1.8_skillen_slope_deg10;
+    dp in mm; then the scheme, the fluid, each physical axis's value and the tag, where set;
+    realisation k > 0 of a grid case ends in _rk."""
+    parts = [f"dp{fmt(dp * 1000.0)}mm_ch{fmt(ch)}_{shifting}"]
+    parts += [p for p in (scheme, fluid) if p]
+    parts += [f"{axis_label(k)}{fmt(v) if isinstance(v, (int, float)) else v}" for k, v in axes]
     if realisation:
         tag = f"r{realisation}"
-    return f"{cid}_{tag}" if tag else cid
+    return "_".join(parts + ([tag] if tag else []))
 
 
 @dataclass(frozen=True)
 class Case:
+    """One run of a campaign: its spacing, Ch and shifting method; the conveyor's tag, extra-case
+    overrides and realisation; a scene flow's scheme and fluid; and the values of the campaign's
+    physical grid axes, as (dotted case key, value) pairs."""
     dp: float
     ch: float
     shifting: str
     tag: str | None = None
     overrides: dict = field(default_factory=dict, compare=False, hash=False)
     realisation: int = 0  # grid cases only: 0 runs the case as configured, k > 0 a perturbed start
+    scheme: str | None = None
+    fluid: str | None = None
+    axes: tuple = ()
 
     @property
     def id(self) -> str:
-        return case_id(self.dp, self.ch, self.shifting, self.tag, self.realisation)
+        return case_id(self.dp, self.ch, self.shifting, self.tag, self.realisation, self.scheme, self.fluid,
+                       self.axes)
 
     @property
     def on_grid(self) -> bool:

@@ -17,3 +17,11 @@ def percent(fraction, missing: str = "-") -> str:
     if v == 0.0:
         return "0 %"
     return np.format_float_positional(v, precision=2, unique=False, fractional=False, trim="-") + " %"
+
+
+def with_error(value, se) -> str:
+    """An error (a fraction) in per cent +- 2 se (its sampling error), both to two significant
+    digits, or the value alone where se is unknown."""
+    if se is None or not np.isfinite(se) or not np.isfinite(value):
+        return percent(value, "&ndash;")
+    return f"{percent(value)} &plusmn; {percent(2.0 * se)}"

@@ -2,12 +2,7 @@
 cost, figures with captions, the case table, convergence, stability, configuration, provenance."""
 from __future__ import annotations
 
-import base64
-import datetime as _dt
 import html
-import os
-import platform
-import subprocess
 import warnings
 from pathlib import Path
 
@@ -15,21 +10,8 @@ import numpy as np
 import xarray as xr
 
 from .campaign import ensemble_size
-from .numbers import percent
-
-CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;
-padding:0 1em;color:#222}
-h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
-table{border-collapse:collapse;font-size:.85em}td,th{border:1px solid #ddd;padding:3px 6px;text-align:right}
-th{background:#f3f3f3}td.l,th.l{text-align:left}tr.diverged td{background:#fde2e1}tr.not_steady td{background:#fff4d6}
-figure{margin:1.5em 0}figcaption{font-size:.9em;color:#444;max-width:900px}img{max-width:100%}
-pre{background:#f7f7f7;padding:.8em;overflow-x:auto;font-size:.85em}
-nav ul{display:flex;flex-wrap:wrap;gap:.3em 1.2em;list-style:none;padding:0;margin:0}
-p.lead{font-size:1.05em}td.ok{background:#d9f2e6}td.warn{background:#fff4d6}td.bad{background:#fde2e1}
-table.verdict td{vertical-align:top}table.verdict td.l{max-width:640px}
-"""
-
+from .numbers import percent, with_error as _with_error
+from .page import figure_html, page, provenance_html, reason_html, write  # noqa: F401 (write for callers)
 
 def _fmt(v, digits=3):
     if isinstance(v, str):
@@ -45,20 +27,8 @@ def _fmt(v, digits=3):
     return f"{v:.{digits}g}"
 
 
-def _commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, timeout=5).stdout.strip() or "unknown"
-    except Exception:
-        return "unknown"
 
 
-def _with_error(value, se) -> str:
-    """An error (a fraction) in per cent +- 2 se (its sampling error), both to two significant
-    digits, or the value alone where se is unknown."""
-    if se is None or not np.isfinite(se) or not np.isfinite(value):
-        return percent(value, "&ndash;")
-    return f"{percent(value)} &plusmn; {percent(2.0 * se)}"
 
 
 def case_table(ds: xr.Dataset) -> str:
@@ -74,7 +44,7 @@ def case_table(ds: xr.Dataset) -> str:
         reason = str(ds["case_reason"].values[i])
         cells = [f'<td class="l">{html.escape(str(cid))}</td>',
                  f'<td class="l" title="{html.escape(reason)}">{html.escape(status)}'
-                 + (f"<br><small>{html.escape(reason)}</small>" if reason else "") + "</td>",
+                 + (f"<br><small>{reason_html(reason)}</small>" if reason else "") + "</td>",
                  f'<td>{"yes" if int(ds["case_steady"].values[i]) else "no"}</td>']
         for k in ("case_wall_time", "case_steps", "case_cfl_acoustic", "case_n_particles", "case_steady_state_time"):
             cells.append(f"<td>{_fmt(ds[k].values[i])}</td>")
@@ -149,7 +119,7 @@ def convergence_table(ds: xr.Dataset) -> str:
     of the station depth-mean u*, for each Ch and shifting with three or more resolutions: the
     (Ch, shifting) sequences that have data (a grid's excluded or wholly diverged ones do not)."""
     from .convergence import gci
-    from .verdict import MAX_ORDER
+    from .convergence import MAX_ORDER
     if ds.sizes["dp"] < 3:
         return "<p>Fewer than three resolutions: no observed order or GCI.</p>"
     st = ds["station"].values
@@ -234,7 +204,8 @@ def verdict_table(ds: xr.Dataset) -> str:
 def accuracy_table(ds: xr.Dataset, thresholds=(0.01, 0.05)) -> str:
     """Per metric: the cheapest steady run under each threshold, and per shifting method at
     the paper's Ch the GCI-extrapolated value, its band and the dp needed for 1 %."""
-    from .verdict import MAX_ORDER, MIN_ORDER, accuracy_rows
+    from .convergence import MAX_ORDER, MIN_ORDER
+    from .verdict import accuracy_rows
     rows = accuracy_rows(ds, thresholds)
     out, last = [], None
     for r in rows:
@@ -394,17 +365,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "tip while the front itself held.</p>"
                + ensemble_paragraph(ds))
     figs = [figure_html(path, title, caption) for path, title, caption in figures]
-    import matplotlib
-    import snakemake
-    import solver
-    prov = {"date (UTC)": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M"),
-            "commit": _commit(), "host": platform.node(), "python": platform.python_version(),
-            "sph-surge": solver.__version__, "numpy": np.__version__, "xarray": xr.__version__,
-            "matplotlib": matplotlib.__version__, "snakemake": snakemake.__version__,
-            "numba": ds.attrs.get("version_numba", ""), "cwd": os.getcwd()}
-    prov_html = "<table>" + "".join(f'<tr><th class="l">{html.escape(k)}</th>'
-                                    f'<td class="l">{html.escape(str(v))}</td></tr>'
-                                    for k, v in prov.items()) + "</table>"
+    prov_html = provenance_html(str(ds.attrs.get("version_numba", "")))
     newtonian = ds.attrs.get("rheology", "newtonian") == "newtonian"
     verdict = verdict_table(ds) if newtonian else (
         f"<p>The paper's conclusions are about a Newtonian fluid; this campaign's fluid is "
@@ -438,29 +399,6 @@ def campaign_wall(ds: xr.Dataset) -> str:
     return f"the runs took {(end - start) / 60:.1f} min of wall time (first start to last end); "
 
 
-def figure_html(path, title: str, caption: str) -> str:
-    """A figure embedded in the page (base64), with its title and caption."""
-    data = base64.b64encode(Path(path).read_bytes()).decode()
-    mime = "image/svg+xml" if str(path).endswith(".svg") else "image/png"
-    return (f'<figure id="{html.escape(Path(path).stem)}"><h3>{html.escape(title)}</h3>'
-            f'<img alt="{html.escape(title)}" src="data:{mime};base64,{data}">'
-            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 
 
-def page(title: str, heading: str, lead: str, body: list[tuple[str, str]]) -> str:
-    """The self-contained HTML page: heading, lead, a table of contents, then each (title, html)
-    section."""
-    toc = "".join(f'<li><a href="#{t.lower().replace(" ", "-")}">{html.escape(t)}</a></li>' for t, _ in body)
-    sections = "".join(f'<section id="{t.lower().replace(" ", "-")}"><h2>{html.escape(t)}</h2>{c}</section>'
-                       for t, c in body)
-    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
-            f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>"
-            f"<h1>{html.escape(heading)}</h1>{lead}<nav><ul>{toc}</ul></nav>{sections}</body></html>")
 
-
-def write(text: str, path) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)

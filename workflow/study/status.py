@@ -1,5 +1,5 @@
 """``python -m study status``: each running case's simulated time, drift ratios and when it can
-end, from the progress files the front runs write (solver/progress.py)."""
+end, from the progress files the runs write (solver/progress.py) under results/<campaign>/progress/."""
 from __future__ import annotations
 
 import json
@@ -18,6 +18,8 @@ def line(p: dict, now: float) -> str:
     finite = {q: r for q, r in ratios.items() if r is not None}
     worst = max(finite, key=finite.get) if finite else None
     drift = (f"{finite[worst]:5.2f} ({worst})" if worst else "not judged yet")
+    if not p.get("detector", True):  # a scene run: it ends at its end time
+        drift = "- (runs to its end)"
     if len(finite) < len(ratios):
         drift += f", {len(ratios) - len(finite)} not measurable"
     status = "steady" if p.get("steady") and p["status"] == "running" else p["status"]
@@ -28,19 +30,22 @@ def line(p: dict, now: float) -> str:
             left += f" (no update for {age / 60:.0f} min)"
     else:
         left = ""
-    return (f"{p['case']:<36} {status:<10} t = {p['t']:6.2f}/{p['max_time']:g} s  "
+    name = f"{p['campaign']}/{p['case']}" if p.get("campaign") else p["case"]
+    return (f"{name:<44} {status:<10} t = {p['t']:6.2f}/{p['max_time']:g} s  "
             f"worst drift/allowance {drift:<28} {left}")
 
 
-def show(folder="results/progress", all_cases: bool = False) -> str:
-    """The table of the progress files in ``folder``, running cases first (``all_cases``: also
-    the ended ones)."""
+def show(folder=None, all_cases: bool = False, results="results") -> str:
+    """The table of the progress files in ``folder`` (default: every campaign's under
+    ``results``), running cases first (``all_cases``: also the ended ones)."""
     rows = []
-    for f in sorted(Path(folder).glob("*.json")):
+    files = Path(folder).glob("*.json") if folder else Path(results).glob("*/progress/*.json")
+    for f in sorted(files):
         try:
-            rows.append(json.loads(f.read_text()))
+            row = json.loads(f.read_text())
         except (OSError, ValueError):
             continue
+        rows.append(row | ({} if folder else {"campaign": f.parent.parent.name}))
     now = time.time()
     running = [r for r in rows if r.get("status") == "running"]
     ended = [r for r in rows if r.get("status") != "running"]

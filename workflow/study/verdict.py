@@ -27,17 +27,12 @@ import xarray as xr
 
 from .campaign import ensemble_size
 from .convergence import gci
+from .convergence import MAX_ORDER, MIN_ORDER
 from .numbers import percent
 
 PAPER_CH = 1.8
 PAPER_FINEST_DP = 0.25e-3
 RESOLVED = 0.10  # a difference between two runs below this fraction of the larger is a tie
-# an observed order below this is no asymptotic convergence: no dp is projected from it
-MIN_ORDER = 0.5
-# an observed order above this is unreliable: three values whose differences happen to shrink
-# fast, not convergence; r21^p so large would shrink the GCI band to nothing. Nothing is
-# extrapolated from it (no limit, no band, no dp projected)
-MAX_ORDER = 4.0
 MARGINAL_U = 0.01  # |delta zeta_u| below which shifting "marginally" affects zeta_u (1 % of u_b)
 
 

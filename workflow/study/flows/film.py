@@ -1,52 +1,81 @@
-"""Start-up from rest of a film on an incline (docs/flow-film.md).
-
-A film of depth h on a plane inclined at theta, at rest at t = 0: no slip at z = 0, a free
-surface (u_z = 0) at z = h, z normal to the plane:
-
-  u_t = nu u_zz + g sin(theta),   u(0, t) = 0,   u_z(h, t) = 0,   u(z, 0) = 0.
-
-Solution: the steady film minus a decaying sine series,
-
-  u = (g sin(theta) / nu) (h z - z^2 / 2)
-      - sum_n>=0 (2 g sin(theta) / (nu h lambda_n^3)) sin(lambda_n z) exp(-nu lambda_n^2 t),
-  lambda_n = (2 n + 1) pi / (2 h).
-
-The sin(lambda_n z) are the eigenfunctions with u = 0 at z = 0 and u_z = 0 at z = h; the
-coefficients are the sine coefficients of the steady profile f(z) = h z - z^2 / 2 (f'' = -1,
-f(0) = f'(h) = 0, cos(lambda_n h) = 0): (2 / h) int_0^h f sin(lambda_n z) dz = 2 / (h lambda_n^3)
-by two integrations by parts. The film is the lower half of the start-up plane Poiseuille flow
-between plates at z = 0 and z = 2 h (its midplane is a symmetry plane, u_z = 0), term for term:
-with L = 2 h, 4 F L^2 / (nu pi^3 k^3) = 2 F / (nu h lambda_n^3) for k = 2 n + 1 and
-k^2 pi^2 / L^2 = lambda_n^2. ``velocity`` therefore evaluates solver.exact.poiseuille.
-"""
+"""The film (docs/flow-film.md): a Newtonian film at rest on an incline at t = 0, periodic
+along the plane, against the exact start-up series."""
 from __future__ import annotations
 
+import html
 import math
 
-import numpy as np
+import xarray as xr
 
-from solver import exact
-
-
-def u_max(h: float, nu: float, g: float, theta: float) -> float:
-    """Steady surface velocity g sin(theta) h^2 / (2 nu), the largest velocity of the film at
-    any time (theta in radians)."""
-    return g * math.sin(theta) * h * h / (2.0 * nu)
+from ..grid import Case
+from ..references import film as theory
+from ..schema import ConfigError
+from . import scores
+from .scene import REQUIRED, G, SceneFlow, newtonian, numerics, positive
 
 
-def velocity(z, t: float, h: float, nu: float, g: float, theta: float, terms: int = 200):
-    """u(z, t) of the start-up film (module docstring) from its first ``terms`` terms, for
-    0 <= z <= h (NaN outside), theta in radians. The truncation error is below
-    8 / (pi^3 (2 terms - 1)^2) u_max at t = 0 (the coefficients fall as 1/k^3) and falls as
-    exp(-nu lambda_terms^2 t)."""
-    z = np.asarray(z, dtype=float)
-    u = exact.poiseuille(z, t, 2.0 * h, g * math.sin(theta), nu, terms=terms)
-    return np.where((z >= 0.0) & (z <= h), u, np.nan)
+class Film(SceneFlow):
+    name = "film"
+    title = "the start-up from rest of a film on an incline"
+    scene_keys = {
+        "depth": (REQUIRED, positive, "film depth h, m"),
+        "angle": (REQUIRED, lambda v: positive(v) and v < 90, "incline angle, degrees"),
+        "end_time": (REQUIRED, positive, "simulated seconds"),
+        "output_interval": (None, positive, "seconds between snapshots (default: end_time / 6)"),
+        "coefsound": (10.0, positive, "c0 / sqrt(g h)"),
+    }
+
+    def check(self, cfg: dict) -> None:
+        self.needs_fluids(cfg)
+        for name, fl in cfg["fluids"].items():
+            if not newtonian(fl) or "viscosity" not in fl:
+                raise ConfigError(f"config key fluids.{name}: flow film compares with the Newtonian start-up "
+                                  "series; give a Newtonian fluid (density, viscosity)")
+
+    def u_max(self, cfg: dict, case: Case | None = None) -> float:
+        s = cfg["scene"]
+        fl = self.fluid_of(cfg, case)
+        return theory.u_max(s["depth"], fl["viscosity"] / fl["density"], G, math.radians(s["angle"]))
+
+    def scene(self, cfg: dict, case: Case) -> dict:
+        s = cfg["scene"]
+        dp = case.dp
+        n = max(1, round(s["depth"] / dp))
+        h = n * dp  # a whole number of rows: the depth is the film's
+        fl = self.fluid_of(cfg, case)
+        width = dp * max(n, math.ceil(6.0 * case.ch) + 1)  # the period holds 3 kernel supports
+        theta = math.radians(s["angle"])
+        layers = 3 * dp * max(1, math.ceil(case.ch / 1.5))
+        fl["blocks"] = [{"x": [0.0, width], "z": [0.0, h]}]
+        out = s["output_interval"] or s["end_time"] / 6.0
+        return {
+            "name": case.id, "dp": dp, "ch": case.ch, "fluid": fl,
+            "walls": [{"name": "bed", "x": [0.0, width], "z": [-layers, 0.0]}],
+            "periodic_x": [0.0, width],
+            "gravity": [G * math.sin(theta), -G * math.cos(theta)],
+            "sound": {"coefsound": s["coefsound"], "depth": h},
+            "numerics": numerics(case.scheme, 2.0 / 3.0 * self.u_max(cfg, case), True, n, case.shifting),
+            "time": {"end": s["end_time"], "output_interval": out},
+        }
+
+    def errors_of(self, cfg: dict, fluid: dict | None) -> tuple[str, ...]:
+        return ("profile_error",)
+
+    def measure(self, cfg: dict, case: Case, run: xr.Dataset):
+        s = cfg["scene"]
+        fl = self.fluid_of(cfg, case)
+        depth = self.scene(cfg, case)["fluid"]["blocks"][0]["z"][1]
+        return scores.film_startup(run, depth, fl["viscosity"] / fl["density"], math.radians(s["angle"])), None
+
+    def reference_text(self, cfg: dict, ds: xr.Dataset) -> str:
+        s = cfg["scene"]
+        nus = ", ".join(f"{html.escape(n)} nu = {f['viscosity'] / f['density']:.4g} m2/s"
+                        for n, f in cfg["fluids"].items())
+        return (f"<p>Film depth {1000 * s['depth']:.4g} mm on a plane inclined at {s['angle']:g} deg ({nus}), "
+                "at rest at t = 0, periodic along the plane. "
+                "Reference: the exact start-up series of u_t = nu u_zz + g sin(theta) with no slip at the bed "
+                "and no stress at the surface. Error: at every snapshot after t = 0 the RMS over the fluid "
+                "particles of (u - u_exact) / u_max; the largest over the snapshots is reported.</p>")
 
 
-def settling_time(h: float, nu: float, fraction: float) -> float:
-    """The time past which the surface velocity is within ``fraction`` of u_max, from the
-    slowest term: u_max - u(h, t) = u_max (32 / pi^3) exp(-nu lambda_0^2 t) (the next term is
-    smaller by the factor exp(-8 nu lambda_0^2 t) / 27), so t = (4 h^2 / (pi^2 nu)) ln(32 / (pi^3 fraction));
-    for fraction <= 0.5 the neglected terms move t by less than 1e-3 of it."""
-    return 4.0 * h * h / (math.pi ** 2 * nu) * math.log(32.0 / (math.pi ** 3 * fraction))
+FLOW = Film()

@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from . import film, measure, slump, user
+from ..references import film, slump, user
+from . import measure
 
 G = 9.81
 

@@ -1,170 +1,147 @@
-"""A 2D gravity current from a rectangular release on a horizontal no-slip bed (docs/flow-slump.md).
-
-The release, height H0 and length L0, rests against a free-slip end wall at x = 0, the
-symmetry plane of a two-sided release; A = H0 L0 is the area per unit width of this half.
-x is the distance from the wall, h(x, t) the depth, x_N(t) the front.
-
-Newtonian fluid, kinematic viscosity nu. Lubrication theory (H. E. Huppert, J. Fluid Mech.
-121, 1982, 43-58, the two-dimensional current of constant volume, alpha = 0):
-
-  h_t = beta (h^3 h_x)_x,   beta = g / (3 nu),   h_x = 0 at x = 0,   int_0^x_N h dx = A.
-
-Its similarity solution (derived in ``depth_profile``):
-
-  x_N = eta_N (beta A^3 t)^(1/5),   h = (3 (x_N^2 - x^2) / (10 beta t))^(1/3),
-  eta_N = (10/3)^(1/5) I^(-3/5),   I = int_0^1 (1 - s^2)^(1/3) ds = sqrt(pi) Gamma(4/3) / (2 Gamma(11/6)),
-
-eta_N = 1.41124 (Huppert's 1.411).
-
-Yield-stress fluid (Bingham or Herschel-Bulkley, yield stress tau_y, density rho): the
-current stops where the weight no longer exceeds the yield stress, rho g h |h_x| <= tau_y
-(lubrication limit), which leaves h^2 = 2 tau_y (x_N - x) / (rho g) behind the front,
-whatever the consistency and index.
-"""
+"""The slump (docs/flow-slump.md): a two-sided release [-L0, L0] x [0, H0] on a no-slip bed,
+its front against Huppert's similarity solution (Newtonian) or its arrested shape and runout
+against the lubrication limit (yield stress)."""
 from __future__ import annotations
 
+import html
 import math
 
 import numpy as np
+import xarray as xr
 
-# I = int_0^1 (1 - s^2)^(1/3) ds = B(1/2, 4/3) / 2
-PROFILE_INTEGRAL = math.sqrt(math.pi) * math.gamma(4.0 / 3.0) / (2.0 * math.gamma(11.0 / 6.0))
-ETA_N = (10.0 / 3.0) ** 0.2 * PROFILE_INTEGRAL ** -0.6
-SIMILARITY_EXPONENT = 0.2
-
-# virtual time origin of the front from a rectangular release, in units of L0^2 / (beta H0^3):
-# the lubrication equation solved from the rectangle (600 cells over 3 L0, BDF2 with 200 steps a
-# decade, converged to the digits given) has its front within 0.3 % of
-# eta_N (beta A^3 (t + t_v))^(1/5) past t = 0.3, with t_v = 0.2967 +- 0.0003 for 1 <= t <= 10
-# (tests/test_flow_references.py re-derives it to 3 % on 150 cells)
-RECTANGLE_TIME_SHIFT = 0.297
+from ..grid import Case
+from ..references import slump as theory
+from ..schema import ConfigError
+from . import measure, scores
+from .scene import REQUIRED, G, SceneFlow, newtonian, numerics, positive
 
 
-def spreading_rate(nu: float, g: float) -> float:
-    """beta = g / (3 nu), the coefficient of h_t = beta (h^3 h_x)_x (Huppert 1982, whose g' is g
-    for a current under air)."""
-    return g / (3.0 * nu)
+class Slump(SceneFlow):
+    name = "slump"
+    title = "a viscous gravity current from a rectangular release (slump)"
+    scene_keys = {
+        "height": (REQUIRED, positive, "release height H0, m"),
+        "length": (REQUIRED, positive, "release length L0 from the symmetry plane, m"),
+        "end_time": (REQUIRED, positive, "simulated seconds"),
+        "output_interval": (0.05, positive, "seconds between snapshots"),
+        "coefsound": (10.0, positive, "c0 / sqrt(g H0)"),
+        "bed_length": (None, positive, "bed length from the symmetry plane, m (default: 1.3 times "
+                                       "the farthest reference front, at least 2 L0)"),
+    }
+
+    def check(self, cfg: dict) -> None:
+        self.needs_fluids(cfg)
+        for name, fl in cfg["fluids"].items():
+            if not newtonian(fl) and not positive(fl.get("yield_stress")):
+                raise ConfigError(f"config key fluids.{name}.yield_stress: a yield-stress slump needs "
+                                  "tau_y > 0 (its reference is the arrested shape); a Newtonian fluid "
+                                  "takes viscosity instead")
+
+    def speed(self, cfg: dict, case: Case) -> float:
+        """The velocity scale for surge's shifting floor: the similarity front's speed
+        x_N / (5 t) at t = 1 s, with the fluid's viscosity (its consistency for a yield-stress fluid)."""
+        s = cfg["scene"]
+        fl = self.fluid_of(cfg, case)
+        nu = (fl.get("viscosity") or fl.get("consistency")) / fl["density"]
+        return 0.2 * float(theory.front_position(1.0, s["height"] * s["length"], nu, G))
+
+    def reference_runout(self, cfg: dict, fluid: dict) -> float:
+        """The farthest front the reference predicts by the end time: the similarity front
+        (Newtonian) or the lubrication runout (yield stress)."""
+        s = cfg["scene"]
+        H0, L0 = s["height"], s["length"]
+        if newtonian(fluid):
+            return float(theory.front_position(s["end_time"], H0 * L0, fluid["viscosity"] / fluid["density"], G))
+        return theory.release_runout(H0, L0, fluid["yield_stress"], fluid["density"], G)
+
+    def scene(self, cfg: dict, case: Case) -> dict:
+        s = cfg["scene"]
+        H0, L0, dp = s["height"], s["length"], case.dp
+        fl = self.fluid_of(cfg, case)
+        X = s["bed_length"] or max(1.3 * self.reference_runout(cfg, fl), 2.0 * L0)
+        X = dp * math.ceil(X / dp)
+        layers = 3 * dp * max(1, math.ceil(case.ch / 1.5))  # the wall covers the 2h support
+        fl["blocks"] = [{"x": [-L0, L0], "z": [0.0, H0]}]
+        return {
+            "name": case.id, "dp": dp, "ch": case.ch, "fluid": fl,
+            "walls": [{"name": "bed", "x": [-X - layers, X + layers], "z": [-layers, 0.0]}],
+            "domain": {"x": [-X - layers - 2 * dp, X + layers + 2 * dp], "z": [-layers - 2 * dp, 3.0 * H0]},
+            "gravity": [0.0, -G], "sound": {"coefsound": s["coefsound"], "depth": H0},
+            "numerics": numerics(case.scheme, self.speed(cfg, case), newtonian(fl), H0 / dp, case.shifting),
+            "time": {"end": s["end_time"], "output_interval": s["output_interval"]},
+        }
+
+    def errors_of(self, cfg: dict, fluid: dict | None) -> tuple[str, ...]:
+        if fluid is None or newtonian(fluid):
+            return ("front_error", "exponent_error", "depth_error")
+        return ("runout_error", "shape_error")
+
+    def quantities(self, fluid: dict | None) -> tuple[str, ...]:
+        return ("front_final",) if fluid is None or newtonian(fluid) else ("runout",)
+
+    def measure(self, cfg: dict, case: Case, run: xr.Dataset):
+        s, m = cfg["scene"], cfg["metrics"]
+        fl = self.fluid_of(cfg, case)
+        if newtonian(fl):
+            values = scores.slump_newtonian(run, s["height"], s["length"], fl["viscosity"] / fl["density"],
+                                            m["memory_fraction"])
+        else:
+            values = scores.slump_yield(run, s["height"], s["length"], fl["yield_stress"], fl["density"],
+                                        m["stop_speed"], m["stop_window"])
+        return values, measure.front(run, symmetric=True)
+
+    def reference_text(self, cfg: dict, ds: xr.Dataset) -> str:
+        s = cfg["scene"]
+        lines = [f"<p>Release: height H0 = {1000 * s['height']:.3g} mm, length L0 = {1000 * s['length']:.3g} mm "
+                 "from the symmetry plane (a two-sided release of length 2 L0 on a no-slip bed; both fronts "
+                 "are measured and averaged, so the plane is the free-slip end wall of the half). The front "
+                 "x_N is the outermost fluid particle plus dp / 2.</p><ul>"]
+        for name, fl in (cfg.get("fluids") or {}).items():
+            if newtonian(fl):
+                f = cfg["metrics"]["memory_fraction"]
+                mine = ds["fluid"].values == name
+                t_c = float(np.nanmax(ds["compare_from"].values[mine])) if "compare_from" in ds else math.nan
+                lines.append(
+                    f"<li><b>{html.escape(name)}</b> (nu = {fl['viscosity'] / fl['density']:.4g} m2/s): "
+                    "Huppert's similarity solution (J. Fluid Mech. 121, 1982), x_N = 1.411 (g A^3 t / (3 nu))^(1/5) "
+                    "and its depth profile. The release's memory has faded, and the runs are compared, from "
+                    f"t_c = {t_c:.3g} s: the time past which lubrication theory started from the rectangle has "
+                    f"its front's local exponent within {100 * f:.3g} % of 1/5 (and its front within "
+                    f"{100 * ((1 - f) ** -0.2 - 1):.2g} % of the similarity front). Front error: RMS of "
+                    "x_N / x_ref - 1 over the snapshots from t_c; exponent: the least-squares slope of ln x_N "
+                    "against ln t over the same snapshots; depth profile: the last snapshot, RMS over x &le; 0.95 x_N "
+                    "over the reference's depth at the plane.</li>")
+            else:
+                ratio = self.reference_runout(cfg, fl) / s["height"]
+                lines.append(
+                    f"<li><b>{html.escape(name)}</b> (tau_y = {fl['yield_stress']:.4g} Pa): the arrested shape "
+                    "of the lubrication limit, h^2 = 2 tau_y (x_N - x) / (rho g), and its runout "
+                    f"x_N = {1000 * self.reference_runout(cfg, fl):.4g} mm ({ratio:.2f} H0 from the plane). "
+                    f"The front has stopped once its speed, fitted over {cfg['metrics']['stop_window']:g} s, "
+                    f"stays below {1000 * cfg['metrics']['stop_speed']:.3g} mm/s (the regularised fluid "
+                    "creeps at about tau_y h / mu_max); the runout is the front then.</li>")
+        return "".join(lines) + "</ul>"
+
+    def front_figure(self, cfg: dict) -> str | None:
+        return ("x_N(t) of every run; Newtonian: against the similarity front (log axes; dotted: t_c, "
+                "where the comparison starts); yield stress: against the lubrication runout.")
+
+    def front_reference(self, ax, cfg: dict, fluid: dict, ds: xr.Dataset, name: str) -> None:
+        from .scene_figures import plain_log
+        s = cfg["scene"]
+        if not newtonian(fluid):
+            ax.axhline(1000 * self.reference_runout(cfg, fluid), color="k", ls="--", lw=1.5,
+                       label="lubrication runout")
+            return
+        t = ds["front_time"].values
+        t = t[t > 0]
+        ax.plot(t, 1000 * theory.front_position(t, s["height"] * s["length"], fluid["viscosity"] / fluid["density"], G),
+                "k--", lw=1.5, label="similarity (Huppert 1982)")
+        if "compare_from" in ds:
+            mine = ds["fluid"].values == name
+            ax.axvline(float(np.nanmax(ds["compare_from"].values[mine])), color="0.5", ls=":", lw=1)
+        plain_log(ax)
+        ax.set_xlim(left=max(0.1, float(t.min())))
 
 
-def front_position(t, A: float, nu: float, g: float):
-    """Similarity front x_N = eta_N (g A^3 t / (3 nu))^(1/5) (Huppert 1982, 2D, alpha = 0),
-    eta_N = ``ETA_N`` = 1.41124."""
-    t = np.asarray(t, dtype=float)
-    return ETA_N * (spreading_rate(nu, g) * A ** 3 * t) ** SIMILARITY_EXPONENT
-
-
-def depth_profile(x, t: float, A: float, nu: float, g: float):
-    """Similarity depth h(x, t) = (3 (x_N^2 - x^2) / (10 beta t))^(1/3)
-    = (9 nu x_N^2 / (10 g t))^(1/3) (1 - (x/x_N)^2)^(1/3) for |x| <= x_N, 0 beyond.
-
-    Derivation: with x_N proportional to t^(1/5) the current stretches uniformly, so the
-    depth-averaged velocity is u = x x_N' / x_N = x / (5 t); lubrication gives
-    u = -beta h^2 h_x, so (h^3)_x = -3 x / (5 beta t) and h^3 = 3 (x_N^2 - x^2) / (10 beta t),
-    zero at the front. The volume int_0^x_N h dx = A then fixes x_N = ``front_position``.
-    Symmetric in x (the two-sided release)."""
-    x = np.abs(np.asarray(x, dtype=float))
-    xn = front_position(t, A, nu, g)
-    return np.cbrt(3.0 * np.maximum(xn * xn - x * x, 0.0) / (10.0 * spreading_rate(nu, g) * t))
-
-
-def fit_front_exponent(t, x_front, interval=(0.0, math.inf)) -> tuple[float, float]:
-    """(b, se) of the least-squares line ln x_N = a + b ln t over the samples with t in the
-    closed ``interval`` and t, x_N > 0 finite; se from the residuals' autocorrelation as every
-    fitted trend of the project (solver.steady.trend_bound). The similarity solution
-    has b = 1/5; a front x_N = c (t + t_v)^(1/5) has the local exponent t / (5 (t + t_v)),
-    within 1 % of 1/5 only past ``exponent_time``. NaN, NaN with fewer than 3 samples."""
-    from solver.steady import trend_bound
-    t = np.asarray(t, dtype=float)
-    x = np.asarray(x_front, dtype=float)
-    ok = np.isfinite(t) & np.isfinite(x) & (t > 0) & (x > 0) & (t >= interval[0]) & (t <= interval[1])
-    if ok.sum() < 3:
-        return float("nan"), float("nan")
-    return trend_bound(np.log(t[ok]), np.log(x[ok]))
-
-
-def memory_time(L0: float, A: float, nu: float, g: float, fraction: float = 0.01) -> float:
-    """The time past which the front from a rectangular release (length L0, area A, height
-    H0 = A / L0) is within ``fraction`` of the similarity front ``front_position``.
-
-    After T. V. Ball and H. E. Huppert ("Similarity solutions and viscous gravity current
-    adjustment times", J. Fluid Mech., 2019), who measure the approach by the relative front
-    difference p between the solution from a given initial shape and the similarity solution.
-    Scaled by L0, H0 and L0^2 / (beta H0^3), the lubrication equation from the rectangle has no
-    parameter left; its front is x_N = eta_N (beta A^3 (t + t_v))^(1/5) with
-    t_v = ``RECTANGLE_TIME_SHIFT`` L0^2 / (beta H0^3), found numerically (module constant).
-    Then p = (1 + t_v / t)^(1/5) - 1, so
-
-      t_m = t_v / ((1 + fraction)^5 - 1),
-
-    1 %: t_m = 5.8 L0^2 / (beta H0^3), where the similarity front is at 2.0 L0; 5 %: 1.1, at
-    1.43 L0: the criterion x_N >= 2 L0 is the 1 % criterion. This is lubrication theory from
-    the start; a release that is not shallow (H0 not much less than L0) first collapses under
-    forces it leaves out, and for it t_m is an estimate of the order only."""
-    H0 = A / L0
-    t_v = RECTANGLE_TIME_SHIFT * L0 * L0 / (spreading_rate(nu, g) * H0 ** 3)
-    return t_v / ((1.0 + fraction) ** 5 - 1.0)
-
-
-def exponent_time(L0: float, A: float, nu: float, g: float, fraction: float = 0.01) -> float:
-    """The time past which the front from a rectangular release (as ``memory_time``) advances
-    with a local exponent d ln x_N / d ln t = t / (5 (t + t_v)) within ``fraction`` of 1/5:
-    t_e = t_v (1 - fraction) / fraction. 1 %: t_e = 29 L0^2 / (beta H0^3), where the similarity
-    front is at 2.8 L0, five times ``memory_time``(0.01): a fitted exponent (``fit_front_exponent``)
-    needs a later interval than the front itself."""
-    H0 = A / L0
-    t_v = RECTANGLE_TIME_SHIFT * L0 * L0 / (spreading_rate(nu, g) * H0 ** 3)
-    return t_v * (1.0 - fraction) / fraction
-
-
-def final_shape(x, x_N: float, tau_y: float, rho: float, g: float):
-    """Arrested depth of a yield-stress current, h = sqrt(2 tau_y (x_N - x) / (rho g)) for
-    |x| <= x_N, 0 beyond: the lubrication stopping condition rho g h |h_x| = tau_y integrated
-    from h(x_N) = 0. The profile of a perfectly plastic layer (J. F. Nye, Proc. R. Soc. A 207,
-    1951, for ice sheets; K. F. Liu and C. C. Mei, J. Fluid Mech. 207, 1989, for Bingham fluid;
-    G. P. Matson and A. J. Hogg, J. Non-Newtonian Fluid Mech. 142, 2007, 79-94, for the arrested
-    dam break of Herschel-Bulkley fluid). Independent of the consistency and the index.
-    Symmetric in x."""
-    x = np.abs(np.asarray(x, dtype=float))
-    return np.sqrt(2.0 * tau_y * np.maximum(x_N - x, 0.0) / (rho * g))
-
-
-def final_runout(A: float, tau_y: float, rho: float, g: float) -> float:
-    """Front x_N of the arrested current of area A when it has ``final_shape`` all the way to
-    the wall: A = int_0^x_N h dx = (2/3) sqrt(2 tau_y / (rho g)) x_N^(3/2), so
-    x_N = (9 A^2 rho g / (8 tau_y))^(1/3). Its depth at the wall is (3 A tau_y / (rho g))^(1/3);
-    a release lower than that does not yield at the wall (``release_runout``)."""
-    return (9.0 * A * A * rho * g / (8.0 * tau_y)) ** (1.0 / 3.0)
-
-
-def release_runout(H0: float, L0: float, tau_y: float, rho: float, g: float) -> float:
-    """Arrested front of a rectangular release (height H0, length L0) in the lubrication limit.
-
-    Where the surface is flat the fluid is unyielded, so fluid near the wall moves only once
-    the slumping front has lowered it. If H0^3 >= 3 A tau_y / (rho g) (A = H0 L0) the whole
-    release yields and x_N = ``final_runout``(A); otherwise a plateau h = H0 stays at the wall
-    up to x_1 = L0 - rho g H0^2 / (3 tau_y), ``final_shape`` beyond it, and the volume
-    gives x_N = L0 + rho g H0^2 / (6 tau_y). Both give x_N = 1.5 L0 at H0^2 = 3 tau_y L0 / (rho g)."""
-    if H0 ** 3 >= 3.0 * H0 * L0 * tau_y / (rho * g):
-        return final_runout(H0 * L0, tau_y, rho, g)
-    return L0 + rho * g * H0 * H0 / (6.0 * tau_y)
-
-
-def release_shape(x, H0: float, L0: float, tau_y: float, rho: float, g: float):
-    """Arrested depth of a rectangular release in the lubrication limit: ``final_shape`` through
-    ``release_runout``, capped at H0 (the plateau that stays at the wall when the release does
-    not yield there; where it does, the shape is below H0 everywhere and the cap does nothing)."""
-    x_N = release_runout(H0, L0, tau_y, rho, g)
-    return np.minimum(final_shape(x, x_N, tau_y, rho, g), H0)
-
-
-def runout_ratio(H0: float, L0: float, tau_y: float, rho: float, g: float) -> float:
-    """x_N / H0: the arrested front's distance from the end wall (``release_runout``) over the
-    release height."""
-    return release_runout(H0, L0, tau_y, rho, g) / H0
-
-
-def spreads_five_heights(H0: float, L0: float, tau_y: float, rho: float, g: float) -> bool:
-    """Whether the release spreads to at least 5 times its height: the arrested front's
-    distance from the end wall is at least 5 H0 (``runout_ratio`` >= 5), the front having
-    started at L0. The half-current is then at least 5 times as long as the release is high."""
-    return runout_ratio(H0, L0, tau_y, rho, g) >= 5.0
+FLOW = Slump()
