@@ -3,7 +3,7 @@ host, from short runs.
 
 Each grid case of the config runs --time s of simulated time (--fine-time below dp = 0.4 mm) on
 --threads threads, after a compile run, from the solver case file the campaign writes for it
-(study.config.case_dict; cold start, --set overrides on top). A run gives particles N, steps,
+(study.flows.conveyor.case_dict; cold start, --set overrides on top). A run gives particles N, steps,
 mean dt, particle-steps/s of its time stepping and its start-up (the rest of its wall time),
 and a case then costs
 

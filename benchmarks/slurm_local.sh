@@ -86,5 +86,5 @@ snakemake -s "$ROOT/Snakefile" --configfile "$ROOT/tests/data/mini.yaml" \
     2>&1 | tee "$WORK/snakemake.log"
 echo "--- jobs (squeue, finished ones kept for MinJobAge):"
 squeue -t all -o "%.6i %.45k %.10T %.8M %.4C"
-ls -l "$WORK/reports/report.html"
+ls -l "$WORK/reports/mini/report.html"
 echo "summary: the miniature campaign through profiles/slurm in $((SECONDS - START)) s"

@@ -57,6 +57,11 @@ def campaign(metric, steady=lambda dp, ch, sh: True, status=lambda dp, ch, sh: "
                 "z_star": z_star},
         attrs={"h_n_m": 0.01876, "normalising_depth_m": 0.0186})
     ds = ds.assign_coords(case=("case", [cid[ix] for ix in flat]))
+    ds["case_dp"] = ("case", [dps[ix[0]] for ix in flat])
+    ds["case_ch"] = ("case", [chs[ix[1]] for ix in flat])
+    ds["case_shifting"] = ("case", [shifts[ix[2]] for ix in flat])
+    ds["case_on_grid"] = ("case", [1 for _ in flat])
+    ds["case_realisation"] = ("case", [0 for _ in flat])
     ds["case_status"] = ("case", [stat[ix] for ix in flat])
     ds["case_reason"] = ("case", ["" for _ in flat])
     ds["case_steady"] = ("case", [int(st[ix]) for ix in flat])

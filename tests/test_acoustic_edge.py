@@ -9,6 +9,7 @@ import pytest
 
 from solver import acoustic_edge, forces
 import study.config as cfgmod
+from study.flows import conveyor
 from solver.conveyor import build_scene, case_from_dict
 from solver.scene import SceneError
 from solver.simulation import Simulation
@@ -116,10 +117,10 @@ def test_rule_does_not_bind_on_the_shipped_grids(config):
     rule's bound lies above it (by 1.4 % at the least: the paper grid's dp = 1 mm, Ch = 2.2), so
     their runs are those measured without it."""
     cfg = cfgmod.load(ROOT / "config" / config)
-    for case in cfgmod.cases(cfg):
-        numerics = case_from_dict(cfgmod.case_dict(cfg, case)).numerics  # the scheme's, resolved
+    for case in conveyor.cases(cfg):
+        numerics = case_from_dict(conveyor.case_dict(cfg, case)).numerics  # the scheme's, resolved
         assert numerics.cfl_rule == "damping", case.id
-        scene = build_scene(case_from_dict(cfgmod.case_dict(cfg, case)))
+        scene = build_scene(case_from_dict(conveyor.case_dict(cfg, case)))
         assert scene.cfl_acoustic == numerics.cfl, case.id
         bound = acoustic_edge.MARGIN * acoustic_edge.edge(scene.ch, scene.acoustic_damping_ratio,
                                                           scene.numerics.density_diffusion)

@@ -127,3 +127,27 @@ def test_snakemake_report_takes_the_registered_captions(campaign):
     for spec in FIGURES:
         assert any(n.endswith(f"{spec.name}.png") for n in names) == (spec.name in drawn), spec.name
     assert "Pareto front (no case is both cheaper and more accurate)" in text
+
+
+def test_a_physical_sweep_reports_each_value_against_its_own_theory(tmp_path):
+    """A two-slope miniature campaign: each run records its own slope and is scored against it,
+    the dataset holds the slope of every case, and the report draws the sweep figure."""
+    cfg = yaml.safe_load(MINI.read_text())
+    cfg.pop("extra_cases")
+    cfg["ensemble"] = {"realisations": 1}
+    cfg["grid"]["case.slope_deg"] = [15.3, 20.0]
+    cfg["start_check"] = False
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    p = snakemake(tmp_path, path)
+    assert p.returncode == 0, p.stderr[-4000:]
+    ds = xr.load_dataset(tmp_path / "results" / "sweep" / "campaign.nc")
+    assert list(ds["case_axis_slope_deg"].values) == [15.3, 15.3, 20.0, 20.0]
+    from study.reference import recorded_case
+    for cid, slope in zip(ds["case"].values, ds["case_axis_slope_deg"].values):
+        run = xr.load_dataset(tmp_path / "results" / "sweep" / "cases" / str(cid) / "run.nc")
+        assert recorded_case(run).slope_deg == slope
+    assert np.all(np.isfinite(ds["case_zeta_h"].values))
+    html = (tmp_path / "reports" / "sweep" / "report.html").read_text()
+    assert "Errors against dp for each value of the physical axes" in html
+    assert "<b>Physical axes</b>: slope_deg = 15.3, 20.0" in html

@@ -249,3 +249,54 @@ def test_a_diverged_run_is_recorded_with_its_reason_and_no_errors(tmp_path):
     flow_of(cfg).write_figures(cfg, ds, tmp_path / "figures")
     html = flow_of(cfg).render(cfg, ds, tmp_path / "figures")
     assert "1 of 2 runs did not complete" in html and "diverged: density deviation 0.2 exceeds 0.1" in html
+
+
+# ---- a physical axis ----------------------------------------------------------------------
+
+def test_a_physical_axis_scores_each_run_against_its_own_theory(tmp_path):
+    """config/film_angle.yaml sweeps the incline: each case's scene has its own gravity, and a
+    run holding the exact start-up profile of its own angle scores ~0 while the same profile
+    scored as another angle's run is off by the ratio of the two u_max; the reduced dataset
+    holds the angle as a coordinate and one convergence sequence for each angle."""
+    from solver.output import write_atomic
+    from study.config import load
+    cfg = load(ROOT / "config" / "film_angle.yaml")
+    flow = flow_of(cfg)
+    cs = cases(cfg)
+    assert [dict(c.axes)["scene.angle"] for c in cs] == [5.0] * 3 + [15.3] * 3 + [30.0] * 3
+    for c in cs:
+        g = scene_dict(cfg, c)["gravity"]
+        assert math.degrees(math.atan2(g[0], -g[1])) == pytest.approx(dict(c.axes)["scene.angle"], rel=1e-12)
+    h, nu = 0.02, 5.6 / 1383.0
+    z = np.arange(0.5e-3, h, 1e-3)
+
+    def run_at(angle):
+        theta = math.radians(angle)
+        run = fake_run([0.0, 0.1], [(z * 0, z, film.velocity(z, t, h, nu, G, theta)) for t in (0.0, 0.1)], 1e-3)
+        run.attrs.update(wall_time_s=1.0, steps=10, n_particles=z.size)
+        return run
+
+    for c in cs:
+        write_atomic(flow.score(cfg, c.id, run_at(dict(c.axes)["scene.angle"])), tmp_path / c.id / "metrics.nc")
+    ds = flow.reduce(cfg, tmp_path)
+    assert np.all(ds["profile_error"].values < 1e-9)  # every run against its own angle's series
+    wrong = flow.score(cfg, cs[-1].id, run_at(5.0))  # a 5 deg profile scored as a 30 deg run
+    ratio = math.sin(math.radians(5.0)) / math.sin(math.radians(30.0))
+    assert float(wrong["profile_error"]) > 0.5 * (1 - ratio)
+    assert list(ds["angle"].values) == [5.0] * 3 + [15.3] * 3 + [30.0] * 3
+    from study.flows.runs import sequences
+    assert [s["axes"] for s in sequences(ds)] == [(("angle", 5.0),), (("angle", 15.3),), (("angle", 30.0),)]
+    flow.write_figures(cfg, ds, tmp_path / "figures")
+    html = flow.render(cfg, ds, tmp_path / "figures")
+    assert "newtonian angle 30</b>: surge's velocity profile error" in html
+
+
+def test_an_axis_must_name_a_key_of_the_flow():
+    cfg = config("film")
+    cfg["grid"]["scene.slope"] = [5.0, 10.0]
+    with pytest.raises(ConfigError, match="config key grid.scene.slope: a scene axis is scene.KEY with KEY one of"):
+        validate(cfg)
+    cfg = config("film")
+    cfg["grid"]["fluids.water.viscosity"] = [1.0]
+    with pytest.raises(ConfigError, match="config key grid.fluids.water.viscosity: a fluid axis"):
+        validate(cfg)

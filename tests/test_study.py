@@ -665,3 +665,28 @@ def test_each_run_is_scored_against_the_theory_of_its_own_physical_case(tmp_path
         assert zeta_fs < 1e-12 and zeta_u < 1e-12 and zeta_h < 1e-12
     a, b = (physics_of(case_from_dict(cfgmod.case_dict(cfg, c))) for c in cfgmod.cases(cfg))
     assert a != b and {k for k in a if a[k] != b[k]} == {"slope_deg"}
+
+
+def test_a_physical_axis_of_the_conveyor_gives_each_case_its_own_physics():
+    """grid: {case.slope_deg: [...]}: every dp x Ch x shifting point at each slope, the slope in
+    the case id and in the case file (so in the physics each run is scored against), the start
+    checks at the first slope only, a warm start from the same slope, and an axis that would set
+    what the grid sets refused."""
+    from study.config import validate
+    from study.flows.conveyor import case_dict, cases, solver_case, warm_source
+    from study.schema import ConfigError
+    grid = {"dp": [0.003, 0.002], "ch": [1.5], "shifting": ["lind"], "case.slope_deg": [10.0, 20.0]}
+    cfg = validate({"case": {}, "grid": grid, "warm_start": True})
+    cs = cases(cfg)
+    assert [c.id for c in cs] == ["dp3mm_ch1.5_lind_slope_deg10", "dp2mm_ch1.5_lind_slope_deg10",
+                                  "dp3mm_ch1.5_lind_slope_deg20", "dp2mm_ch1.5_lind_slope_deg20",
+                                  "dp2mm_ch1.5_lind_slope_deg10_paper-start"]
+    by_id = {c.id: c for c in cs}
+    assert [case_dict(cfg, c)["slope_deg"] for c in cs] == [10.0, 10.0, 20.0, 20.0, 10.0]
+    h10, h20 = (solver_case(cfg, by_id[f"dp2mm_ch1.5_lind_slope_deg{s}"]).h_n for s in (10, 20))
+    assert h20 < h10  # a steeper slope: a thinner film, each run's own theory
+    assert warm_source(cfg, by_id["dp2mm_ch1.5_lind_slope_deg20"]).id == "dp3mm_ch1.5_lind_slope_deg20"
+    with pytest.raises(ConfigError, match="config key grid.case.dp: dp is set by the grid itself"):
+        validate({"case": {}, "grid": {**grid, "case.dp": [0.001]}})
+    with pytest.raises(ConfigError, match="config key grid"):
+        validate({"case": {}, "grid": {**grid, "slope_deg": [10.0]}})  # an axis is a dotted campaign key

@@ -8,7 +8,7 @@ import yaml
 import xarray as xr
 
 from . import stability
-from .grid import Case
+from .grid import Case, axis_label
 
 SCALARS = ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se", "zeta_h", "zeta_h_se", "zeta_h_paper",
            "zeta_h_paper_se", "zeta_fs", "zeta_fs_se", "zeta_fs_measured",
@@ -133,8 +133,11 @@ def worst_member(members: list[tuple]) -> tuple:
 
 def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
           front_particles: int = 4000) -> xr.Dataset:
-    """The campaign dataset from each case's run and metrics datasets (same order)."""
-    grid = [c for c in cases if c.on_grid]
+    """The campaign dataset from each case's run and metrics datasets (same order). The grid
+    arrays over (dp, ch, shifting) hold the grid cases at the physical axes' first values (those
+    of the first case); every case, each axis's value included, is in the flat ``case`` table."""
+    base = next((c.axes for c in cases if c.on_grid), ())
+    grid = [c for c in cases if c.on_grid and c.axes == base]
     dps = sorted({c.dp for c in grid}, reverse=True)
     chs = sorted({c.ch for c in grid})
     shs = list(dict.fromkeys(c.shifting for c in grid))
@@ -163,7 +166,7 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     n_real = np.zeros(shape, dtype=int)
     cells: dict[tuple, list] = {}
     for c, run, m in zip(cases, runs, metrics):
-        if c.on_grid:
+        if c.on_grid and c.axes == base:
             cells.setdefault((dps.index(c.dp), chs.index(c.ch), shs.index(c.shifting)), []).append((c, run, m))
     for ix, members in cells.items():
         members.sort(key=lambda cm: cm[0].realisation)
@@ -238,6 +241,15 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["case_ch"] = ("case", [c.ch for c in cases])
     ds["case_shifting"] = ("case", [c.shifting for c in cases])
     ds["case_on_grid"] = ("case", [int(c.on_grid) for c in cases])
+    axes = list(dict.fromkeys(k for c in cases for k, _ in c.axes))
+    ds["case_realisation"] = ("case", [c.realisation for c in cases])
+    for key in axes:  # each physical axis's value of each case (NaN or "": a case without it)
+        values = [dict(c.axes).get(key) for c in cases]
+        numeric = all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in values)
+        values = ([np.nan if v is None else float(v) for v in values] if numeric
+                  else ["" if v is None else str(v) for v in values])
+        ds[f"case_axis_{axis_label(key)}"] = ("case", values, {"long_name": f"physical axis {key}"})
+    ds.attrs["axes"] = ",".join(axis_label(k) for k in axes)
     ds["case_tag"] = ("case", np.array([c.tag or "" for c in cases], dtype=str))
     ds["case_status"] = ("case", [r.attrs["status"] for r in runs])
     ds["case_steady"] = ("case", [int(m["steady"]) for m in metrics])

@@ -1,4 +1,4 @@
-"""Two campaign datasets (``results/campaign.nc``), case by case: each metric's change in units of
+"""Two campaign datasets (``results/<name>/campaign.nc``), case by case: each metric's change in units of
 their combined standard error, z = (new - old) / sqrt(se_new^2 + se_old^2), with status, steps and
 steady time. Pure functions over xarray.
 
@@ -6,7 +6,7 @@ A solver change that should leave the physics alone (round-off, speed) should le
 campaign's metrics within their run-to-run spread: |z| mostly within 2 (if the se describe that
 spread, noise alone puts about 1 value in 20 beyond it), and no case far beyond.
 
-    python -m study.compare NEW/results/campaign.nc OLD/results/campaign.nc
+    python -m study.compare NEW/results/config/campaign.nc OLD/results/config/campaign.nc
 """
 from __future__ import annotations
 

@@ -66,12 +66,21 @@ def matches(selector: dict, dp: float, ch: float, shifting: str) -> bool:
     return all(values[k] == (v if k == "shifting" else float(v)) for k, v in selector.items())
 
 
+def physical_axes(grid: dict) -> list[tuple[str, list]]:
+    """The grid's physical axes: (dotted campaign key, values) for each key with a dot."""
+    return [(k, v) for k, v in grid.items() if "." in k]
+
+
 def expand(grid: dict, extra: list[dict] | None = None,
            realisations: int | Callable[[float, float, str], int] = 1) -> list[Case]:
     """Cases of the grid (``combine``: product, or paper = every Ch with the first shifting
-    method plus every method at ``paper_ch``), less those matching an ``exclude`` entry, each
-    in ``realisations`` realisations (0, 1, ...; a number, or a function of dp, ch and
-    shifting), followed by the extra cases; ids unique."""
+    method plus every method at ``paper_ch``), less those matching an ``exclude`` entry, for
+    every combination of the physical axes' values (``physical_axes``), each in
+    ``realisations`` realisations (0, 1, ...; a number, or a function of dp, ch and shifting),
+    followed by the extra cases; ids unique."""
+    import itertools
+    axes_keys = [k for k, _ in physical_axes(grid)]
+    points = [tuple(zip(axes_keys, values)) for values in itertools.product(*(v for _, v in physical_axes(grid)))]
     count = realisations if callable(realisations) else (lambda dp, ch, sh: int(realisations))
     dps, chs, shifts = grid["dp"], grid["ch"], grid["shifting"]
     combine = grid.get("combine", "product")
@@ -81,20 +90,22 @@ def expand(grid: dict, extra: list[dict] | None = None,
         return any(matches(e, dp, ch, sh) for e in excluded)
 
     cases = []
-    for dp in dps:
-        for ch in chs:
-            for sh in shifts:
-                if combine == "paper" and sh != shifts[0] and ch != grid.get("paper_ch", 1.8):
-                    continue
-                if left_out(float(dp), float(ch), sh):
-                    continue
-                n = count(float(dp), float(ch), sh)
-                cases.extend(Case(float(dp), float(ch), sh, realisation=k) for k in range(n))
+    for axes in points:
+        for dp in dps:
+            for ch in chs:
+                for sh in shifts:
+                    if combine == "paper" and sh != shifts[0] and ch != grid.get("paper_ch", 1.8):
+                        continue
+                    if left_out(float(dp), float(ch), sh):
+                        continue
+                    n = count(float(dp), float(ch), sh)
+                    cases.extend(Case(float(dp), float(ch), sh, realisation=k, axes=axes) for k in range(n))
     for e in extra or []:
         cases.append(Case(float(e["dp"]), float(e["ch"]), e["shifting"], e.get("tag"),
                           dict(e.get("overrides") or {})))
     ids = [c.id for c in cases]
     dup = sorted({i for i in ids if ids.count(i) > 1})
     if dup:
-        raise ValueError(f"extra_cases: duplicate case id(s) {', '.join(dup)}; give each a distinct 'tag'")
+        raise ValueError(f"duplicate case id(s) {', '.join(dup)}: give each extra case a distinct 'tag', and "
+                         "each physical axis a key whose last part differs")
     return cases

@@ -363,7 +363,7 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
                "equivalent front (the fluid area downstream of a lab-fixed point over h_n) over the same "
                "second: where zeta_f reads more than it, the toe wandered or particles joined or left the "
                "tip while the front itself held.</p>"
-               + ensemble_paragraph(ds))
+               + ensemble_paragraph(ds) + axes_paragraph(ds))
     figs = [figure_html(path, title, caption) for path, title, caption in figures]
     prov_html = provenance_html(str(ds.attrs.get("version_numba", "")))
     newtonian = ds.attrs.get("rheology", "newtonian") == "newtonian"
@@ -387,6 +387,19 @@ def render(ds: xr.Dataset, figures: list[tuple[Path, str, str]], config_text: st
     lead = (f"<p class='lead'>{n} cases{ensemble}, {n_steady} steady, {counts.get('diverged', 0)} diverged; "
             f"{campaign_wall(ds)}{wall / 60:.0f} min of simulation wall time summed over the cases. {question}</p>")
     return page("sph-surge campaign report", "sph-surge campaign report", lead, body)
+
+
+def axes_paragraph(ds: xr.Dataset) -> str:
+    """What a campaign with physical axes reports where ('' without)."""
+    axes = [a for a in str(ds.attrs.get("axes", "")).split(",") if a]
+    if not axes:
+        return ""
+    values = "; ".join(f"{html.escape(a)} = " + ", ".join(
+        html.escape(str(v)) for v in dict.fromkeys(ds[f"case_axis_{a}"].values.tolist())) for a in axes)
+    return (f"<p><b>Physical axes</b>: {values}. Every run is scored against the theory of its own "
+            "physical case. The verdict, the accuracy table and Figs. 2-13 take each axis's first "
+            "value; the case table and the sweep figure (errors against dp for each value) every "
+            "value.</p>")
 
 
 def campaign_wall(ds: xr.Dataset) -> str:

@@ -1,12 +1,14 @@
-"""The flows beyond the conveyor front (docs/flows.md): their references, what a run's
-snapshots say about them, and a run's errors. Pure functions over numbers, arrays and xarray
-objects:
+"""The flows a campaign runs (docs/flows.md), one module each, every one a ``base.Flow`` that
+``study.registry`` finds by the campaign's ``flow`` key:
 
-  slump    a 2D gravity current released from a rectangle on a horizontal bed: Huppert's
-           viscous similarity solution, and the arrested shape of a yield-stress fluid
-  film     start-up from rest of a film on an incline
-  user     front positions and depth or velocity profiles read from CSV files, and the
-           errors of a run against them
-  measure  the front, depth and velocity profiles of a scene run's snapshots
-  scores   each flow's errors with their sampling errors (study.flowcampaign calls them)
+  conveyor       the paper's conveyor-belt front (its metrics, verdict and report: study.metrics,
+                 study.campaign, study.verdict, study.report, study.figures)
+  slump          a release from a rectangle: Huppert's similarity front, or the arrested shape
+  film           start-up from rest of a film on an incline
+  user           any scene file against the user's CSV reference data
+
+What the three scene flows share: ``scene`` (keys, grid, numerics, reduction, report),
+``scene_figures``, ``runs`` (sequences over dp, convergence, trust), ``measure`` (the front,
+depth and velocity profiles of a run's snapshots) and ``scores`` (errors with their sampling
+errors). Their references are in study.references.
 """

@@ -10,7 +10,7 @@ from pathlib import Path
 import xarray as xr
 
 from .. import layout
-from ..grid import Case, expand, matches
+from ..grid import Case, expand, matches, physical_axes
 from ..startcheck import START_CHECK_TAG
 from ..schema import ConfigError, checked
 from .base import Flow
@@ -29,7 +29,6 @@ SOLVER_KEYS = {
 GRID_KEYS = ("dp", "ch", "shifting", "name")  # each case's own: not in case nor case_overrides
 
 
-
 def _message(err) -> str:
     """The schema's message, or for a case mapping that sets what the grid sets, which keys."""
     if err.validator == "required" and not err.absolute_path and "'case'" in err.message:
@@ -46,9 +45,19 @@ def _message(err) -> str:
     return err.message
 
 
+def base_axes(cfg: dict) -> tuple:
+    """The physical axes at their first values: the point the verdict and the paper's figures
+    take (() without axes)."""
+    return tuple((k, v[0]) for k, v in physical_axes(cfg["grid"]))
+
+
 def validate(config: dict) -> dict:
     """The schema (with its defaults), then every case as the solver reads it."""
     cfg = checked(config, SCHEMA, _message)
+    for key, _ in physical_axes(cfg["grid"]):
+        if key.split(".")[1] in GRID_KEYS:
+            raise ConfigError(f"config key grid.{key}: {key.split('.')[1]} is set by the grid itself "
+                              "(grid.dp, grid.ch, grid.shifting), not by a physical axis")
     try:
         expanded = cases(cfg)
     except ValueError as exc:
@@ -85,7 +94,7 @@ def start_checks(cfg: dict, found: list[Case]) -> list[Case]:
     """With ``start_check``: at the finest grid dp, for each shifting method, the grid case at the
     Ch nearest grid.paper_ch run once more from the paper's start (``PAPER_START``), tagged
     START_CHECK_TAG. None where the campaign's own cases start that way already."""
-    grid = [c for c in found if c.on_grid and c.realisation == 0]
+    grid = [c for c in found if c.on_grid and c.realisation == 0 and c.axes == base_axes(cfg)]
     if not cfg.get("start_check", True) or not grid:
         return []
     finest = min(c.dp for c in grid)
@@ -93,7 +102,7 @@ def start_checks(cfg: dict, found: list[Case]) -> list[Case]:
     checks = []
     for sh in dict.fromkeys(c.shifting for c in grid if c.dp == finest):
         c = min((c for c in grid if c.dp == finest and c.shifting == sh), key=lambda c: (abs(c.ch - paper_ch), c.ch))
-        checks.append(Case(c.dp, c.ch, sh, START_CHECK_TAG, dict(PAPER_START)))
+        checks.append(Case(c.dp, c.ch, sh, START_CHECK_TAG, dict(PAPER_START), axes=c.axes))
     from solver.conveyor import case_from_dict
     from solver.scene import SceneError
     try:
@@ -129,7 +138,7 @@ def warm_source(cfg: dict, case: Case) -> Case | None:
     if not cfg.get("warm_start") or not case.on_grid:
         return None
     coarser = [c for c in configured_cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
-               and c.dp > case.dp]
+               and c.axes == case.axes and c.dp > case.dp]
     if not coarser:
         return None
     dp = min(c.dp for c in coarser)
@@ -147,12 +156,18 @@ def solver_case(cfg: dict, case: Case | None = None):
 def case_dict(cfg: dict, case: Case) -> dict:
     """The solver's case file (solver.conveyor) for one campaign case: ``case``, then each
     ``case_overrides`` entry whose ``where`` the case matches (in order), then an extra
-    case's own ``overrides``."""
+    case's own ``overrides``, then the case's values of the physical axes."""
     d = copy.deepcopy(cfg["case"])
     for entry in cfg.get("case_overrides") or []:
         if matches(entry["where"], case.dp, case.ch, case.shifting):
             d = _merge(d, entry["case"])
     d = _merge(d, case.overrides)
+    for key, value in case.axes:  # a physical axis: case.KEY (dotted) set to this case's value
+        node = d
+        parts = key.split(".")[1:]
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+        node[parts[-1]] = value
     src = warm_source(cfg, case)
     if src is not None:
         d.update(start="warm", warm_from=layout.run_path(cfg, src.id))
@@ -289,13 +304,14 @@ class Conveyor(Flow):
     def figures(self, cfg: dict) -> list[tuple[str, str, str]]:
         from ..figures import figures_for
         ch = cfg["figures"]["profile_ch"]
-        return [(spec.name, spec.title, spec.full_caption(ch)) for spec in figures_for(has_yield_stress(cfg))]
+        specs = figures_for(has_yield_stress(cfg), bool(physical_axes(cfg["grid"])))
+        return [(spec.name, spec.title, spec.full_caption(ch)) for spec in specs]
 
     def write_figures(self, cfg: dict, ds: xr.Dataset, outdir) -> list[Path]:
         from ..figures import figures_for, write_all
         f = cfg["figures"]
         return write_all(ds, outdir, figure_settings(cfg, ds), fmt=f["format"], dpi=f["dpi"],
-                         specs=figures_for(has_yield_stress(cfg)))
+                         specs=figures_for(has_yield_stress(cfg), bool(physical_axes(cfg["grid"]))))
 
     def render(self, cfg: dict, ds: xr.Dataset, figure_dir) -> str:
         import yaml

@@ -25,22 +25,31 @@ def seconds(v) -> str:
     return f"{v:.0f}" if v >= 10 else f"{v:.2g}"
 
 
+def group_label(fluid: str, axes=()) -> str:
+    """A fluid and its physical axes' values, e.g. 'newtonian angle 5'."""
+    parts = [fluid] if fluid else []
+    return " ".join(parts + [f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}" for k, v in axes])
+
+
 def series_label(seq) -> str:
-    parts = [seq["fluid"]] if seq["fluid"] else []
-    return " ".join(parts + [seq["scheme"], seq["shifting"], f"Ch {seq['ch']:g}"])
+    head = group_label(seq["fluid"], seq.get("axes", ()))
+    return " ".join(([head] if head else []) + [seq["scheme"], seq["shifting"], f"Ch {seq['ch']:g}"])
 
 
 def sequences(ds: xr.Dataset) -> list[dict]:
-    """The (fluid, scheme, ch, shifting) groups of cases, each with its case indices by
-    falling dp."""
+    """The (fluid, physical axes' values, scheme, ch, shifting) groups of cases, each with its
+    case indices by falling dp: one convergence sequence a value of each physical axis."""
+    axes = [a for a in str(ds.attrs.get("axes", "")).split(",") if a]
     keys = {}
     for i in range(ds.sizes["case"]):
-        k = tuple(str(ds[c].values[i]) for c in ("fluid", "scheme", "shifting")) + (float(ds["ch"].values[i]),)
+        values = tuple((a, ds[a].values[i].item()) for a in axes)
+        values = tuple((a, v) for a, v in values if v == v and v != "")  # this case's own axes
+        k = tuple(str(ds[c].values[i]) for c in ("fluid", "scheme", "shifting")) + (float(ds["ch"].values[i]), values)
         keys.setdefault(k, []).append(i)
     out = []
-    for (fluid, scheme, shifting, ch), idx in keys.items():
+    for (fluid, scheme, shifting, ch, values), idx in keys.items():
         idx = sorted(idx, key=lambda i: -float(ds["dp"].values[i]))
-        out.append({"fluid": fluid, "scheme": scheme, "shifting": shifting, "ch": ch, "cases": idx})
+        out.append({"fluid": fluid, "scheme": scheme, "shifting": shifting, "ch": ch, "axes": values, "cases": idx})
     return out
 
 

@@ -14,12 +14,12 @@ import numpy as np
 import xarray as xr
 
 from ..convergence import MAX_ORDER, MIN_ORDER
-from ..grid import Case
+from ..grid import Case, axis_label
 from ..numbers import percent, with_error
 from ..page import figure_html, page, provenance_html, reason_html
 from ..schema import ConfigError, checked, coerce_scalars
 from .base import Flow
-from .runs import LABELS, mm, seconds, cheapest, convergence, falls_with_dp, sequences, series_label
+from .runs import LABELS, cheapest, convergence, falls_with_dp, group_label, mm, seconds, sequences, series_label
 
 SCHEMA = Path(__file__).resolve().parent / "scene.schema.yaml"
 G = 9.81
@@ -93,11 +93,12 @@ class SceneFlow(Flow):
                 *sorted(Path(references.__file__).parent.glob("*.py"))]
 
     def validate(self, cfg: dict) -> dict:
-        """Schema, then the flow's scene keys and checks, then every case's scene as the solver
-        reads it."""
+        """Schema, then the flow's scene keys and checks, the physical axes, then every case's
+        scene as the solver reads it."""
         cfg = checked(cfg, self.schema)
         self._scene_keys(cfg)
         self.check(cfg)
+        self._check_axes(cfg)
         from solver.scene import SceneError, scene_from_dict
         for name, fl in (cfg.get("fluids") or {}).items():  # each fluid as the solver reads it
             try:
@@ -107,7 +108,7 @@ class SceneFlow(Flow):
                 raise ConfigError(f"config key fluids.{name}: {exc}") from None
         for c in self.cases(cfg):
             try:
-                scene_from_dict(self.scene(cfg, c))
+                scene_from_dict(self.case_dict(cfg, c))
             except (SceneError, OSError) as exc:
                 where = f"fluids.{c.fluid}" if c.fluid else "scene"
                 raise ConfigError(f"case {c.id} ({where}): {exc}") from None
@@ -136,16 +137,59 @@ class SceneFlow(Flow):
             raise ConfigError(f"config key fluids: flow {self.name} needs at least one fluid, e.g. "
                               "fluids: {newtonian: {density: 1383.0, viscosity: 5.6}}")
 
+    @staticmethod
+    def axes(cfg: dict) -> list[tuple[str, list]]:
+        """The physical axes of the grid: (dotted campaign key, values), in the config's order."""
+        return [(k, v) for k, v in cfg["grid"].items() if "." in k]
+
+    def _check_axes(self, cfg: dict) -> None:
+        """ConfigError for an axis that names no scene key of the flow or no key of a fluid."""
+        fluids = cfg.get("fluids") or {}
+        for key, _ in self.axes(cfg):
+            parts = key.split(".")
+            if parts[0] == "scene" and (len(parts) != 2 or parts[1] not in self.scene_keys):
+                raise ConfigError(f"config key grid.{key}: a scene axis is scene.KEY with KEY one of "
+                                  + ", ".join(self.scene_keys))
+            if parts[0] == "fluids" and (len(parts) != 3 or parts[1] not in fluids):
+                raise ConfigError(f"config key grid.{key}: a fluid axis is fluids.NAME.KEY with NAME one of "
+                                  + (", ".join(fluids) or "the campaign's fluids (it has none)"))
+
     def cases(self, cfg: dict) -> list[Case]:
-        """fluid x scheme x shifting x Ch x dp (each in the config's order), one case each."""
+        """fluid x axes x scheme x shifting x Ch x dp (each in the config's order), one case each;
+        an axis on one fluid's key varies that fluid's cases only."""
+        import itertools
         g = cfg["grid"]
         fluids = list(cfg.get("fluids") or {}) or [None]
-        return [Case(float(dp), float(ch), sh, scheme=scheme, fluid=fl)
-                for fl in fluids for scheme in g["scheme"] for sh in g["shifting"] for ch in g["ch"]
-                for dp in g["dp"]]
+        out = []
+        for fl in fluids:
+            own = [(k, v) for k, v in self.axes(cfg) if not k.startswith("fluids.") or k.split(".")[1] == fl]
+            for values in itertools.product(*(v for _, v in own)):
+                axes = tuple((k, v) for (k, _), v in zip(own, values))
+                out += [Case(float(dp), float(ch), sh, scheme=scheme, fluid=fl, axes=axes)
+                        for scheme in g["scheme"] for sh in g["shifting"] for ch in g["ch"] for dp in g["dp"]]
+        ids = [c.id for c in out]
+        dup = sorted({i for i in ids if ids.count(i) > 1})
+        if dup:
+            raise ConfigError(f"config key grid: two axes give the same case id(s) {', '.join(dup)}: "
+                              "give them keys whose last parts differ")
+        return out
+
+    @staticmethod
+    def case_config(cfg: dict, case: Case) -> dict:
+        """The campaign as ``case`` sees it: each physical axis's key set to the case's value."""
+        if not case.axes:
+            return cfg
+        cfg = copy.deepcopy(cfg)
+        for key, value in case.axes:
+            node = cfg
+            parts = key.split(".")
+            for p in parts[:-1]:
+                node = node[p]
+            node[parts[-1]] = value
+        return cfg
 
     def case_dict(self, cfg: dict, case: Case) -> dict:
-        return self.scene(cfg, case)
+        return self.scene(self.case_config(cfg, case), case)
 
     def fluid_of(self, cfg: dict, case: Case | None) -> dict:
         fluids = cfg.get("fluids") or {}
@@ -171,7 +215,7 @@ class SceneFlow(Flow):
         values: dict = {}
         series = None
         if status != "diverged" and run.sizes.get("snapshot", 0) > 1:
-            values, series = self.measure(cfg, case, run)
+            values, series = self.measure(self.case_config(cfg, case), case, run)  # its own theory
         ds = xr.Dataset({k: ((), float(v)) for k, v in values.items()})
         if series is not None:
             ds["x_front"] = series.rename({"t": "front_time"})
@@ -198,6 +242,11 @@ class SceneFlow(Flow):
         coords = {"case": [c.id for c in cs], "dp": ("case", [c.dp for c in cs]),
                   "ch": ("case", [c.ch for c in cs]), "shifting": ("case", [c.shifting for c in cs]),
                   "scheme": ("case", [c.scheme for c in cs]), "fluid": ("case", [c.fluid or "" for c in cs])}
+        for key, _ in self.axes(cfg):  # a physical axis: its value, NaN (or "") where a case has none
+            values = [dict(c.axes).get(key) for c in cs]
+            numeric = all(isinstance(v, (int, float)) or v is None for v in values)
+            coords[axis_label(key)] = ("case", [(math.nan if v is None else float(v)) if numeric
+                                                else ("" if v is None else str(v)) for v in values])
         data = {k: ("case", [float(m[k]) if k in m else math.nan for m in rows]) for k in names}
         data["status"] = ("case", [m.attrs["status"] for m in rows])
         data["reason"] = ("case", [m.attrs["reason"] for m in rows])
@@ -207,6 +256,7 @@ class SceneFlow(Flow):
         if fronts:
             ds["x_front"] = xr.concat(fronts, dim="case", join="outer").reindex(case=ds["case"].values)
         ds.attrs["flow"] = self.name
+        ds.attrs["axes"] = ",".join(axis_label(k) for k, _ in self.axes(cfg))  # the physical axes' coords
         ds.attrs["config_yaml"] = yaml.safe_dump(cfg, sort_keys=False)
         return ds
 
@@ -216,12 +266,14 @@ class SceneFlow(Flow):
         trustworthy run."""
         tol = cfg["metrics"]["tolerance"]
         out = []
-        for fname, fl in self.fluid_dicts(cfg).items():
-            errs = self.errors_of(cfg, fl or None)
+        groups: dict = {}  # (fluid, values of the physical axes) -> case indices
+        for seq in sequences(ds):
+            groups.setdefault((seq["fluid"], seq["axes"]), []).extend(seq["cases"])
+        fluids = self.fluid_dicts(cfg)
+        for (fname, values), idx in groups.items():
+            errs = self.errors_of(cfg, fluids.get(fname) or None)
             head = errs[0]
-            idx = [i for i in range(ds.sizes["case"]) if str(ds["fluid"].values[i]) == fname]
-            if not idx:
-                continue
+            idx = sorted(idx)
             parts = []
             for scheme in dict.fromkeys(str(ds["scheme"].values[i]) for i in idx):
                 sub = [i for i in idx if str(ds["scheme"].values[i]) == scheme]
@@ -247,7 +299,8 @@ class SceneFlow(Flow):
                 cheap = (f"the cheapest run with every error below {percent(tol)} is "
                          f"{html.escape(str(ds['case'].values[best]))} "
                          f"({seconds(ds['wall_time_s'].values[best])} s)")
-            who = f"<b>{html.escape(fname)}</b>: " if fname else ""
+            label = group_label(fname, values)
+            who = f"<b>{html.escape(label)}</b>: " if label else ""
             out.append(f"<li>{who}{'; '.join(parts)}; {cheap}.</li>")
         return "<ul>" + "".join(out) + "</ul>"
 
@@ -374,7 +427,12 @@ class SceneFlow(Flow):
                 "front and are not judged here: this report answers how close each run comes to its reference, "
                 "at what cost, and whether surge's departures from the paper's scheme (spec) help or hurt on "
                 "this flow.</p>")
-        body = [("Answer", self.answer(cfg, ds)), ("Reference", self.reference_text(cfg, ds)),
+        axes = self.axes(cfg)
+        sweep = ("" if not axes else "<p>Physical axes: " + "; ".join(
+            f"{html.escape(k)} = {', '.join(map(str, v))}" for k, v in axes)
+            + ". Each run is scored against the reference of its own values; the text below states the "
+            "campaign's base values. Each value of an axis is its own convergence sequence.</p>")
+        body = [("Answer", self.answer(cfg, ds)), ("Reference", sweep + self.reference_text(cfg, ds)),
                 ("Accuracy and cost", "<p>One row a run (its case id shows over its dp). Errors in "
                  "per cent &plusmn; 2 se, the sampling error from the particle noise of the measurement (not "
                  "the discretisation error).</p>" + self.case_table(cfg, ds)),

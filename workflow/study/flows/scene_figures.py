@@ -12,6 +12,7 @@ import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
 from ..figures import _log_axes, _plain, _PlainLogFormatter  # noqa: E402
+from ..grid import Case, axis_label  # noqa: E402
 from .runs import LABELS, mm, sequences, series_label  # noqa: E402
 
 
@@ -72,13 +73,19 @@ def fronts(flow, cfg: dict, ds: xr.Dataset):
     fluids = flow.fluid_dicts(cfg)
     names = [n for n in fluids if any(str(f) == n for f in ds["fluid"].values)]
     fig, axes = plt.subplots(1, len(names), figsize=(5.2 * len(names), 4), squeeze=False)
+    keys = {axis_label(k): k for k, _ in flow.axes(cfg)}
     for ax, name in zip(axes[0], names):
-        for i in range(ds.sizes["case"]):
-            if str(ds["fluid"].values[i]) != name:
+        for seq in sequences(ds):
+            if seq["fluid"] != name:
                 continue
-            x = ds["x_front"].isel(case=i).dropna("front_time")
-            ax.plot(x["front_time"], 1000 * x, lw=1, label=f"{ds['scheme'].values[i]} dp {mm(ds['dp'].values[i])}")
-        flow.front_reference(ax, cfg, fluids[name], ds, name)
+            for i in seq["cases"]:
+                x = ds["x_front"].isel(case=i).dropna("front_time")
+                ax.plot(x["front_time"], 1000 * x, lw=1, label=f"{series_label(seq)} dp {mm(ds['dp'].values[i])}")
+        # the reference of each value of the physical axes (the campaign's own where it has none)
+        for values in dict.fromkeys(seq["axes"] for seq in sequences(ds) if seq["fluid"] == name):
+            own = flow.case_config(cfg, Case(0.0, 0.0, "", fluid=name or None,
+                                             axes=tuple((keys[a], v) for a, v in values)))
+            flow.front_reference(ax, own, flow.fluid_dicts(own)[name], ds, name)
         ax.set_xlabel("t [s]")
         ax.set_ylabel("front x_N [mm]")
         ax.set_title(name, fontsize=9)

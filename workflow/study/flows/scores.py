@@ -140,11 +140,11 @@ def film_startup(ds, depth: float, nu: float, theta: float) -> dict:
 
 
 def user_scores(ds, refs: dict, front_from: float, symmetric: bool) -> dict:
-    """Against a user's reference files (study.flows.user): the front (RMS relative error over
+    """Against a user's reference files (study.references.user): the front (RMS relative error over
     the reference times >= front_from), each depth profile at its time (the snapshot at that
     time), each velocity profile at its station (the last snapshot, the particles within dp / 2
     of the station's x, or all of them in a scene periodic in x), the run's profile interpolated
-    linearly onto the reference's abscissas (study.flows.user.on_reference); a kind's error is
+    linearly onto the reference's abscissas (study.references.user.on_reference); a kind's error is
     the RMS over its profiles."""
     out = {}
     if "front" in refs:
