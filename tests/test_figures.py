@@ -160,6 +160,9 @@ def test_every_axis_of_every_figure_has_plain_tick_labels():
             fig.canvas.draw()
         for ax in fig.axes:
             for axis in (ax.xaxis, ax.yaxis):
+                if axis.get_label_text() and axis.get_visible():  # a labelled axis is numbered
+                    shown = [t.get_text() for t in axis.get_ticklabels() if t.get_visible() and t.get_text()]
+                    assert shown, (spec.name, axis.get_label_text())
                 for label in _tick_labels(axis):
                     assert not any(m in label for m in ("$", "10^", "times", "×", "e+", "e-")), (spec.name, label)
                 if axis.get_scale() == "log" and axis.axis_name == "y":  # the errors

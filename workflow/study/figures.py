@@ -216,6 +216,7 @@ def fig_velocity_profiles(ds, ch, ref):
                         lw=1, label=f"dp = {dp * 1000:g} mm")
             ax.set_title(f"x* = {s:g}, {sh}")
             ax.set_xlabel("u* = (u + u_b) / u_b")
+            ax.tick_params(labelbottom=True)  # every labelled axis numbered, shared or not
             if j == 0:
                 ax.set_ylabel("z* = z / h_n")
     axs[0][-1].legend(fontsize=8)
