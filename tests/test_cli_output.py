@@ -135,6 +135,7 @@ def test_a_killed_scene_run_resumes_from_its_checkpoint_bit_for_bit(tmp_path):
     assert subprocess.run(cmd + ["-o", str(out)]).returncode == 0
     assert not ckpt.exists()
     a, b = xr.load_dataset(ref), xr.load_dataset(out)
+    assert b.attrs["resumed_from_checkpoint"] == 1 and a.attrs["resumed_from_checkpoint"] == 0
     assert a.attrs["steps"] == b.attrs["steps"] and a.sizes == b.sizes
     for v in a.data_vars:
         np.testing.assert_array_equal(a[v].values, b[v].values, err_msg=v)

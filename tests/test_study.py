@@ -690,3 +690,26 @@ def test_a_physical_axis_of_the_conveyor_gives_each_case_its_own_physics():
         validate({"case": {}, "grid": {**grid, "case.dp": [0.001]}})
     with pytest.raises(ConfigError, match="config key grid"):
         validate({"case": {}, "grid": {**grid, "slope_deg": [10.0]}})  # an axis is a dotted campaign key
+
+
+@pytest.mark.slow
+def test_two_campaign_files_never_share_a_name(tmp_path):
+    """Each campaign writes under its own name (its file's stem, or name:); a second file that
+    claims a name in use is refused before any job starts, naming the key and the other file,
+    so that campaigns whose cases share an id but differ in a case key never share a run."""
+    base = {"case": {}, "grid": {"dp": [0.004], "ch": [1.5], "shifting": ["lind"]}, "start_check": False}
+
+    def dry(name, cfg):
+        path = tmp_path / name
+        path.write_text(yaml.safe_dump(cfg))
+        return subprocess.run([sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-n", "--cores", "1",
+                               "--configfile", str(path)], cwd=tmp_path, capture_output=True, text=True)
+
+    a = dry("a.yaml", base)
+    b = dry("b.yaml", {**base, "case": {"slope_deg": 20.0}})  # the same case id, another slope
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    assert "results/a/cases/dp4mm_ch1.5_lind/run.nc" in a.stdout
+    assert "results/b/cases/dp4mm_ch1.5_lind/run.nc" in b.stdout
+    c = dry("c.yaml", {**base, "name": "a"})
+    assert c.returncode != 0
+    assert "config key name: 'a' is the name of the campaign a.yaml" in c.stdout + c.stderr

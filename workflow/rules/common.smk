@@ -35,12 +35,15 @@ def _write_if_changed(path, text):
 
 
 # One campaign file a name: a second file with the same name would share its runs and report.
+# The file is recorded relative to the working directory where it lies inside it (a moved
+# checkout keeps its campaigns).
 _SOURCE = f"{R}/campaign_source.txt"
-if os.path.exists(_SOURCE) and open(_SOURCE).read().strip() != CAMPAIGN_FILE:
+_FILE = os.path.relpath(CAMPAIGN_FILE) if not os.path.relpath(CAMPAIGN_FILE).startswith("..") else CAMPAIGN_FILE
+if os.path.exists(_SOURCE) and os.path.abspath(open(_SOURCE).read().strip()) != CAMPAIGN_FILE:
     raise ConfigError(f"config key name: {config['name']!r} is the name of the campaign "
-                      f"{open(_SOURCE).read().strip()}, whose results are in {R}/; give {CAMPAIGN_FILE} "
+                      f"{open(_SOURCE).read().strip()}, whose results are in {R}/; give {_FILE} "
                       "another name (name: ...), or delete that folder")
-_write_if_changed(_SOURCE, CAMPAIGN_FILE + "\n")
+_write_if_changed(_SOURCE, _FILE + "\n")
 
 # The merged, validated config for our CLIs; rewritten only when it changes. Rules take it as
 # a param, not an input, and list the settings they use as params, so a change to figure

@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import html
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,8 @@ from .runs import LABELS, cheapest, convergence, falls_with_dp, group_label, mm,
 SCHEMA = Path(__file__).resolve().parent / "scene.schema.yaml"
 G = 9.81
 REQUIRED = object()  # a scene key without a default
+
+
 def positive(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0
 
@@ -88,7 +91,7 @@ class SceneFlow(Flow):
     def metric_sources(self) -> list[Path]:
         from .. import references
         here = Path(__file__).resolve().parent
-        return [Path(__file__), Path(__import__(type(self).__module__, fromlist=["_"]).__file__),
+        return [Path(__file__), Path(sys.modules[type(self).__module__].__file__),
                 here / "scores.py", here / "measure.py", here / "base.py",
                 *sorted(Path(references.__file__).parent.glob("*.py"))]
 
@@ -150,6 +153,11 @@ class SceneFlow(Flow):
             if parts[0] == "scene" and (len(parts) != 2 or parts[1] not in self.scene_keys):
                 raise ConfigError(f"config key grid.{key}: a scene axis is scene.KEY with KEY one of "
                                   + ", ".join(self.scene_keys))
+            if parts[0] == "scene":
+                _, check, what = self.scene_keys[parts[1]]
+                for v in dict(self.axes(cfg))[key]:
+                    if not check(v):
+                        raise ConfigError(f"config key grid.{key}: {v!r} is not valid: {what}")
             if parts[0] == "fluids" and (len(parts) != 3 or parts[1] not in fluids):
                 raise ConfigError(f"config key grid.{key}: a fluid axis is fluids.NAME.KEY with NAME one of "
                                   + (", ".join(fluids) or "the campaign's fluids (it has none)"))
