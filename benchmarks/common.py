@@ -21,7 +21,8 @@ ROOT = Path(__file__).absolute().parents[1]  # not resolved: a linked package (b
 EXAMPLES = ROOT / "examples"
 RESULTS = ROOT / "results" / "benchmarks"
 
-# the metric grids of the default campaign (config/config.yaml's metrics)
+# the metric grids of the default campaign (metrics.free_surface_x_star's default in
+# workflow/study/flows/conveyor.schema.yaml)
 X_STAR_RANGE = (0.0, 12.0)
 
 

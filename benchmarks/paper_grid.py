@@ -99,7 +99,7 @@ def t_sim_of(specs, method: str, dp: float) -> float:
 
 
 def start_checks(cfg: dict) -> list[tuple[float, float, str]]:
-    """(dp, ch, method) of the campaign's start checks (study.config.start_checks)."""
+    """(dp, ch, method) of the campaign's start checks (study.flows.conveyor.start_checks)."""
     from study.flows.conveyor import START_CHECK_TAG, cases
     return [(c.dp, c.ch, c.shifting) for c in cases(cfg) if c.tag == START_CHECK_TAG]
 

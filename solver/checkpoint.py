@@ -37,18 +37,19 @@ class Checkpointer:
         if self.wall_next is None and self.wall_interval is not None:
             self.wall_next = wall + self.wall_interval
         due_wall = self.wall_next is not None and wall >= self.wall_next
-        if runner.sim.t >= self.next - 1e-12 or due_wall:
-            self.save(runner)
-            if runner.sim.t >= self.next - 1e-12:
+        due_sim = runner.sim.t >= self.next - 1e-12
+        if due_sim or due_wall:
+            if due_sim:
                 self.next += self.interval
             if self.wall_next is not None:
                 self.wall_next = wall + self.wall_interval
+            self.save(runner)
 
     def save(self, runner):
         state = {"key": self.key, "sim": runner.sim.state(), "res": runner.res,
                  "next_out": runner.next_out, "next_diag": runner.next_diag,
                  "next_monitor": runner.next_monitor, "monitors": runner.monitors,
-                 "next_checkpoint": self.next + self.interval, "wall_time": runner.elapsed(),
+                 "next_checkpoint": self.next, "wall_time": runner.elapsed(),
                  "start": self.start}
         folder = os.path.dirname(os.path.abspath(self.path))
         os.makedirs(folder, exist_ok=True)

@@ -14,7 +14,7 @@ def _parser() -> argparse.ArgumentParser:
     c = sub.add_parser("check", help="validate a scene or a conveyor case file and print its particle count")
     c.add_argument("scene", help="scene YAML file, or a conveyor case file (as for front)")
     r = sub.add_parser("run", help="run a scene to its end time and write a NetCDF result")
-    r.add_argument("scene", help="scene YAML file (see docs/scenes.md)")
+    r.add_argument("scene", help="scene YAML file (see docs/scene.md)")
     f = sub.add_parser("front", help="run the conveyor-belt flow-front case to steady state")
     f.add_argument("case", help="case YAML file (see docs/conveyor.md)")
     for p, what in ((r, "scene"), (f, "case")):
@@ -33,7 +33,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="exit 0 when a diverged (or, for front, unsteady) run was written (campaigns record it)")
     w = sub.add_parser("warm", help="compile and cache every numba kernel (before parallel jobs)")
     w.add_argument("cases", nargs="*", default=[],
-                   help="front case files whose settings to compile as well (at a coarse dp)")
+                   help="front case files or scenes whose settings to compile as well (a case at a coarse dp, "
+                        "a scene as it is)")
     w.add_argument("--touch", default=None, help="file to create when done")
     return ap
 

@@ -69,6 +69,7 @@ def to_dataset(res: RunResult) -> xr.Dataset:
         "steps": res.steps,
         "wall_time_s": res.wall_time,
         "started_unix": res.started_unix,
+        "resumed_from_checkpoint": int(res.resumed),
         "ended_unix": time.time(),
         "threads": res.threads,
         "n_particles": res.n_particles,

@@ -29,6 +29,7 @@ class RunResult:
     cg_iterations: int = 0  # of the implicit viscous solves, over the steps this process ran
     rkc_stages: int = 0  # of the sub-stepped viscous updates, over the steps this process ran
     started_unix: float = field(default_factory=_time.time)  # when the run first started (kept on resume)
+    resumed: int = 0  # 1: this process resumed the run from a checkpoint
     diag_time: list = field(default_factory=list)
     diag: dict = field(default_factory=lambda: {k: [] for k in DIAGNOSTICS})
     snap_time: list = field(default_factory=list)
@@ -189,6 +190,7 @@ def run_scene(scene: Scene, quiet: bool = True, sim: Simulation | None = None, c
         saved = ckpt.load()
         if saved is not None:
             ckpt.restore(runner, saved)
+            runner.res.resumed = 1
     report = ProgressFile(progress, scene.name, None, scene.time.end) if progress else None
     res = runner.run(quiet, on_step=chain(ckpt, report))
     if report is not None:

@@ -1,6 +1,6 @@
 """Each default is written once: the solver's case dataclasses hold the case defaults, the
 campaign schema holds the campaign's own. What repeats them must agree:
-- the schema's defaults of the keys every solver case also takes (study.config.SOLVER_KEYS);
+- the schema's defaults of the keys every solver case also takes (study.flows.conveyor.SOLVER_KEYS);
 - the table of case keys in docs/conveyor.md (every key documented, every default as coded);
 - config/config.yaml and config/stability.yaml set only what differs from a default;
 - config/paper.yaml pins the paper's physical case, which must be the solver's default case,

@@ -1,5 +1,6 @@
 # The figures and captions come from the flow (FLOW.figures: for the conveyor, the registry
-# study.figures.FIGURES; the plug map only with a Herschel-Bulkley case).
+# study.figures.FIGURES; the plug map only with a Herschel-Bulkley case, the sweep figure
+# only with a physical axis).
 from study.figures import rst_text
 
 FMT = config["figures"]["format"]

@@ -114,7 +114,7 @@ def main(argv=None) -> int:
     p.add_argument("config"); p.add_argument("--results", required=True, help="the folder of the cases")  # noqa: E702
     p.add_argument("-o", "--output", required=True)
     p.set_defaults(fn=cmd_reduce)
-    p = sub.add_parser("figures", help="the paper's figures from the campaign dataset")
+    p = sub.add_parser("figures", help="the campaign's figures (its flow's) from the campaign dataset")
     p.add_argument("config"); p.add_argument("campaign"); p.add_argument("-o", "--outdir", required=True)  # noqa: E702
     p.set_defaults(fn=cmd_figures)
     p = sub.add_parser("report", help="self-contained HTML report")

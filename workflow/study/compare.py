@@ -1,4 +1,4 @@
-"""Two campaign datasets (``results/<name>/campaign.nc``), case by case: each metric's change in units of
+"""Two conveyor campaign datasets (``results/<name>/campaign.nc``), case by case: each metric's change in units of
 their combined standard error, z = (new - old) / sqrt(se_new^2 + se_old^2), with status, steps and
 steady time. Pure functions over xarray.
 

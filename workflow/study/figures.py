@@ -510,7 +510,7 @@ FIGURES = (
                "(realisation 0) against dp, one line for each value of the campaign's physical axes, "
                "shifting method and Ch, each run against the theory of its own physical case; bars: "
                "2 se. Not in the paper: it shows where the scheme holds as the physics changes. The "
-               "verdict and Figs. 2-13 take the axes' first values.",
+               "verdict and Figs. 2-11 and 13 take the axes' first values.",
                lambda ds, st: fig_sweep(ds), sweep_only=True),
 )
 FIGURE_NAMES = tuple(f.name for f in FIGURES)

@@ -38,7 +38,8 @@ def commit() -> str:
 
 
 def provenance(numba_version: str = "") -> dict:
-    """Date, commit, host, working directory and the versions of Python and every package."""
+    """Date, commit, host, working directory, and the versions of Python, sph-surge, numpy,
+    xarray, matplotlib, snakemake and numba."""
     import matplotlib
     import numpy
     import snakemake

@@ -397,9 +397,9 @@ def axes_paragraph(ds: xr.Dataset) -> str:
     values = "; ".join(f"{html.escape(a)} = " + ", ".join(
         html.escape(str(v)) for v in dict.fromkeys(ds[f"case_axis_{a}"].values.tolist())) for a in axes)
     return (f"<p><b>Physical axes</b>: {values}. Every run is scored against the theory of its own "
-            "physical case. The verdict, the accuracy table and Figs. 2-13 take each axis's first "
-            "value; the case table and the sweep figure (errors against dp for each value) every "
-            "value.</p>")
+            "physical case. The verdict, the accuracy table and Figs. 2-11 and 13 take each axis's "
+            "first value; the case table, the stability map (Fig. 12) and the sweep figure (errors "
+            "against dp for each value) every value.</p>")
 
 
 def campaign_wall(ds: xr.Dataset) -> str:

@@ -244,6 +244,7 @@ class Conveyor(Flow):
     def file_keys(self, cfg: dict) -> list[tuple]:
         measured = ((cfg.get("reference") or {}).get("measured") or {})
         keys = [("reference", "measured", "free_surface")] if measured.get("free_surface") else []
+        keys += [("case", "warm_from")] if isinstance((cfg.get("case") or {}).get("warm_from"), str) else []
         return keys + [("reference", "measured", "velocity", k) for k in (measured.get("velocity") or {})]
 
     def validate(self, cfg: dict) -> dict:

@@ -1,7 +1,7 @@
 """What the flows run as scenes (slump, film, user) share (docs/flows.md): the campaign keys and
 grid dp x Ch x shifting x scheme (x fluid), each scene's numerics, the reduction of the runs into
-one dataset over ``case``, and the report: the answer first, then accuracy and cost, convergence,
-stability, the figures, the configuration and provenance. Each flow says what is its own: its
+one dataset over ``case``, and the report: the answer, the reference, then accuracy and cost,
+convergence, stability, the figures, the configuration and provenance. Each flow says what is its own: its
 scene keys and scene, its errors and the reference they are against."""
 from __future__ import annotations
 
@@ -270,8 +270,8 @@ class SceneFlow(Flow):
 
     # ---- report ---------------------------------------------------------------------------
     def answer(self, cfg: dict, ds: xr.Dataset) -> str:
-        """One plain sentence per fluid: the finest run of each scheme and the cheapest
-        trustworthy run."""
+        """One plain sentence per fluid and value of the physical axes: the finest run of each
+        scheme and the cheapest trustworthy run."""
         tol = cfg["metrics"]["tolerance"]
         out = []
         groups: dict = {}  # (fluid, values of the physical axes) -> case indices
