@@ -289,6 +289,7 @@ def test_a_physical_axis_scores_each_run_against_its_own_theory(tmp_path):
     flow.write_figures(cfg, ds, tmp_path / "figures")
     html = flow.render(cfg, ds, tmp_path / "figures")
     assert "newtonian angle 30</b>: surge's velocity profile error" in html
+    assert "<th>angle</th>" in html  # the accuracy table names each run's angle
 
 
 def test_an_axis_must_name_a_key_of_the_flow():

@@ -43,7 +43,7 @@ if os.path.exists(_SOURCE) and os.path.abspath(open(_SOURCE).read().strip()) != 
     raise ConfigError(f"config key name: {config['name']!r} is the name of the campaign "
                       f"{open(_SOURCE).read().strip()}, whose results are in {R}/; give {_FILE} "
                       "another name (name: ...), or delete that folder")
-_write_if_changed(_SOURCE, _FILE + "\n")
+_write_if_changed(_SOURCE, f"{_FILE}\n")
 
 # The merged, validated config for our CLIs; rewritten only when it changes. Rules take it as
 # a param, not an input, and list the settings they use as params, so a change to figure

@@ -50,6 +50,13 @@ def numerics(scheme: str, speed: float, is_newtonian: bool, particles_across: fl
     return num
 
 
+def _value(v) -> str:
+    """A physical axis's value in a table cell: numbers shortest, NaN (a case without it) blank."""
+    if isinstance(v, float):
+        return "" if v != v else f"{v:g}"
+    return str(v)
+
+
 class SceneFlow(Flow):
     """A flow whose cases are scenes run to their end time (``python -m solver run``)."""
 
@@ -314,8 +321,9 @@ class SceneFlow(Flow):
 
     def case_table(self, cfg: dict, ds: xr.Dataset) -> str:
         errs_all = self.all_errors(cfg)
-        head = ("<tr><th>dp</th><th class='l'>fluid</th><th class='l'>scheme</th>"
-                "<th class='l'>shifting</th><th>Ch</th>"
+        axes = [axis_label(k) for k, _ in self.axes(cfg)]
+        head = ("<tr><th>dp</th><th class='l'>fluid</th>" + "".join(f"<th>{html.escape(a)}</th>" for a in axes)
+                + "<th class='l'>scheme</th><th class='l'>shifting</th><th>Ch</th>"
                 + "".join(f"<th>{html.escape(LABELS[e])}</th>" for e in errs_all)
                 + "<th>status</th><th>wall time [s]</th><th>steps</th><th>particles</th></tr>")
         rows = []
@@ -323,6 +331,7 @@ class SceneFlow(Flow):
             status = str(ds["status"].values[i])
             cells = [f"<td title='{html.escape(str(ds['case'].values[i]))}'>{mm(ds['dp'].values[i])}</td>",
                      f"<td class='l'>{html.escape(str(ds['fluid'].values[i]))}</td>",
+                     *(f"<td>{html.escape(_value(ds[a].values[i].item()))}</td>" for a in axes),
                      f"<td class='l'>{html.escape(str(ds['scheme'].values[i]))}</td>",
                      f"<td class='l'>{html.escape(str(ds['shifting'].values[i]))}</td>",
                      f"<td>{ds['ch'].values[i]:g}</td>"]
