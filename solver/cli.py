@@ -117,9 +117,9 @@ def _set_threads(threads) -> bool:
 
 def _front(args) -> int:
     from .conveyor import case_from_dict
+    from .overrides import apply_overrides
     from .scene import SceneError, read_yaml
     try:
-        from .overrides import apply_overrides
         case = case_from_dict(apply_overrides(read_yaml(args.case) or {}, args.set))
     except (SceneError, OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -68,3 +68,19 @@ def worst_density_deviation(sim, t_end: float, t_from: float = 0.2) -> float:
 @pytest.fixture
 def examples_dir():
     return EXAMPLES
+
+
+def kill_after_first_checkpoint(cmd: list, ckpt) -> None:
+    """Start ``cmd`` (a solver run), SIGKILL it as soon as its checkpoint ``ckpt`` exists (a
+    cold numba cache compiles first: up to 10 min), and assert it was still running then."""
+    import signal
+    import subprocess
+    import time
+    p = subprocess.Popen(cmd)
+    t0 = time.time()
+    while not ckpt.exists() and p.poll() is None and time.time() - t0 < 600:
+        time.sleep(0.005)
+    killed = p.poll() is None
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    assert killed, "the run ended before it could be killed"

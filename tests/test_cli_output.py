@@ -105,14 +105,13 @@ def test_a_killed_scene_run_resumes_from_its_checkpoint_bit_for_bit(tmp_path):
     """python -m solver run, as a campaign runs a slump case, killed with SIGKILL once it has
     written a checkpoint, then run again: the result equals an uninterrupted run's, array by
     array, and the checkpoint is gone once the result is written."""
-    import signal
-    import time
     from pathlib import Path
 
     import yaml
 
     from study.config import load
     from study.registry import flow_of
+    from tests.conftest import kill_after_first_checkpoint
     cfg = load(Path(__file__).resolve().parent.parent / "config" / "slump.yaml")
     flow = flow_of(cfg)
     case = next(c for c in flow.cases(cfg) if c.fluid == "newtonian" and c.scheme == "surge")
@@ -123,14 +122,7 @@ def test_a_killed_scene_run_resumes_from_its_checkpoint_bit_for_bit(tmp_path):
     cmd = [sys.executable, "-m", "solver", "run", str(path), "--quiet", "--threads", "1"]
     ref, out, ckpt = tmp_path / "ref.nc", tmp_path / "out.nc", tmp_path / "out.nc.ckpt"
     assert subprocess.run(cmd + ["-o", str(ref), "--no-checkpoint"]).returncode == 0
-    p = subprocess.Popen(cmd + ["-o", str(out)])
-    t0 = time.time()
-    while not ckpt.exists() and p.poll() is None and time.time() - t0 < 600:
-        time.sleep(0.005)
-    killed = p.poll() is None
-    p.send_signal(signal.SIGKILL)
-    p.wait()
-    assert killed, "the run ended before it could be killed"
+    kill_after_first_checkpoint(cmd + ["-o", str(out)], ckpt)
     assert ckpt.exists() and not out.exists()  # nothing that looks finished
     assert subprocess.run(cmd + ["-o", str(out)]).returncode == 0
     assert not ckpt.exists()

@@ -1,9 +1,7 @@
 """The conveyor-belt case: preset geometry, and a killed run resumed from its checkpoint."""
 import math
-import signal
 import subprocess
 import sys
-import time
 from dataclasses import replace
 
 import numpy as np
@@ -15,7 +13,7 @@ from solver import lubrication
 from solver.build import build_particles
 from solver.conveyor import build_scene, case_from_dict, initial_toe, scheme_fluid, wall_thickness
 from solver.scene import SceneError
-from tests.conftest import EXAMPLES, coarse_conveyor_case, worst_density_deviation
+from tests.conftest import EXAMPLES, coarse_conveyor_case, kill_after_first_checkpoint, worst_density_deviation
 
 
 def paper(**changes):
@@ -217,14 +215,7 @@ def test_killed_run_resumes_to_the_same_result(tmp_path):
     assert subprocess.run(cmd + ["-o", str(ref), "--no-checkpoint"]).returncode == 3  # not steady
     out = tmp_path / "out.nc"
     ckpt = tmp_path / "out.nc.ckpt"
-    p = subprocess.Popen(cmd + ["-o", str(out)])
-    t0 = time.time()
-    while not ckpt.exists() and p.poll() is None and time.time() - t0 < 600:  # a cold numba cache compiles first
-        time.sleep(0.005)
-    killed = p.poll() is None
-    p.send_signal(signal.SIGKILL)
-    p.wait()
-    assert killed, "the run ended before it could be killed"
+    kill_after_first_checkpoint(cmd + ["-o", str(out)], ckpt)
     assert ckpt.exists() and not out.exists()  # nothing that looks finished
     assert subprocess.run(cmd + ["-o", str(out)]).returncode == 3
     assert not ckpt.exists()

@@ -8,7 +8,7 @@ import yaml
 import xarray as xr
 
 from . import stability
-from .grid import Case, axis_label
+from .grid import Case, axis_label, axis_values
 
 SCALARS = ("zeta_f", "zeta_f_se", "zeta_f_body", "zeta_f_body_se", "zeta_h", "zeta_h_se", "zeta_h_paper",
            "zeta_h_paper_se", "zeta_fs", "zeta_fs_se", "zeta_fs_measured",
@@ -243,12 +243,8 @@ def build(cases: list[Case], runs: list[xr.Dataset], metrics: list[xr.Dataset],
     ds["case_on_grid"] = ("case", [int(c.on_grid) for c in cases])
     axes = list(dict.fromkeys(k for c in cases for k, _ in c.axes))
     ds["case_realisation"] = ("case", [c.realisation for c in cases])
-    for key in axes:  # each physical axis's value of each case (NaN or "": a case without it)
-        values = [dict(c.axes).get(key) for c in cases]
-        numeric = all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in values)
-        values = ([np.nan if v is None else float(v) for v in values] if numeric
-                  else ["" if v is None else str(v) for v in values])
-        ds[f"case_axis_{axis_label(key)}"] = ("case", values, {"long_name": f"physical axis {key}"})
+    for key in axes:  # each physical axis's value of each case
+        ds[f"case_axis_{axis_label(key)}"] = ("case", axis_values(cases, key), {"long_name": f"physical axis {key}"})
     ds.attrs["axes"] = ",".join(axis_label(k) for k in axes)
     ds["case_tag"] = ("case", np.array([c.tag or "" for c in cases], dtype=str))
     ds["case_status"] = ("case", [r.attrs["status"] for r in runs])

@@ -28,7 +28,8 @@ def case_id(dp: float, ch: float, shifting: str, tag: str | None = None, realisa
     realisation k > 0 of a grid case ends in _rk."""
     parts = [f"dp{fmt(dp * 1000.0)}mm_ch{fmt(ch)}_{shifting}"]
     parts += [p for p in (scheme, fluid) if p]
-    parts += [f"{axis_label(k)}{fmt(v) if isinstance(v, (int, float)) else v}" for k, v in axes]
+    parts += [f"{axis_label(k)}{fmt(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v}"
+              for k, v in axes]
     if realisation:
         tag = f"r{realisation}"
     return "_".join(parts + ([tag] if tag else []))
@@ -103,9 +104,31 @@ def expand(grid: dict, extra: list[dict] | None = None,
     for e in extra or []:
         cases.append(Case(float(e["dp"]), float(e["ch"]), e["shifting"], e.get("tag"),
                           dict(e.get("overrides") or {})))
+    return unique(cases, "give each extra case a distinct 'tag', and each physical axis a key whose "
+                         "last part differs")
+
+
+def set_key(tree: dict, dotted: str, value) -> None:
+    """tree[a][b][c] = value for the key "a.b.c" (a missing mapping on the way is made)."""
+    *path, last = dotted.split(".")
+    for p in path:
+        tree = tree.setdefault(p, {})
+    tree[last] = value
+
+
+def unique(cases: list[Case], how: str) -> list[Case]:
+    """``cases``; ValueError naming the ids that repeat and ``how`` to tell them apart."""
     ids = [c.id for c in cases]
     dup = sorted({i for i in ids if ids.count(i) > 1})
     if dup:
-        raise ValueError(f"duplicate case id(s) {', '.join(dup)}: give each extra case a distinct 'tag', and "
-                         "each physical axis a key whose last part differs")
+        raise ValueError(f"duplicate case id(s) {', '.join(dup)}: {how}")
     return cases
+
+
+def axis_values(cases: list[Case], key: str) -> list:
+    """Each case's value of the physical axis ``key``: floats (NaN for a case without it) where
+    every value is a number, else strings ("" for a case without it)."""
+    values = [dict(c.axes).get(key) for c in cases]
+    if all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in values):
+        return [float("nan") if v is None else float(v) for v in values]
+    return ["" if v is None else str(v) for v in values]

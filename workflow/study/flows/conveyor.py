@@ -10,7 +10,7 @@ from pathlib import Path
 import xarray as xr
 
 from .. import layout
-from ..grid import Case, expand, matches, physical_axes
+from ..grid import Case, expand, matches, physical_axes, set_key
 from ..startcheck import START_CHECK_TAG
 from ..schema import ConfigError, checked
 from .base import Flow
@@ -163,11 +163,7 @@ def case_dict(cfg: dict, case: Case) -> dict:
             d = _merge(d, entry["case"])
     d = _merge(d, case.overrides)
     for key, value in case.axes:  # a physical axis: case.KEY (dotted) set to this case's value
-        node = d
-        parts = key.split(".")[1:]
-        for p in parts[:-1]:
-            node = node.setdefault(p, {})
-        node[parts[-1]] = value
+        set_key(d, key.partition(".")[2], value)
     src = warm_source(cfg, case)
     if src is not None:
         d.update(start="warm", warm_from=layout.run_path(cfg, src.id))

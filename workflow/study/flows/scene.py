@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from ..convergence import MAX_ORDER, MIN_ORDER
-from ..grid import Case, axis_label
+from ..grid import Case, axis_label, axis_values, physical_axes, set_key, unique
 from ..numbers import percent, with_error
 from ..page import figure_html, page, provenance_html, reason_html
 from ..schema import ConfigError, checked, coerce_scalars
@@ -150,19 +150,19 @@ class SceneFlow(Flow):
     @staticmethod
     def axes(cfg: dict) -> list[tuple[str, list]]:
         """The physical axes of the grid: (dotted campaign key, values), in the config's order."""
-        return [(k, v) for k, v in cfg["grid"].items() if "." in k]
+        return physical_axes(cfg["grid"])
 
     def _check_axes(self, cfg: dict) -> None:
         """ConfigError for an axis that names no scene key of the flow or no key of a fluid."""
         fluids = cfg.get("fluids") or {}
-        for key, _ in self.axes(cfg):
+        for key, values in self.axes(cfg):
             parts = key.split(".")
             if parts[0] == "scene" and (len(parts) != 2 or parts[1] not in self.scene_keys):
                 raise ConfigError(f"config key grid.{key}: a scene axis is scene.KEY with KEY one of "
                                   + ", ".join(self.scene_keys))
             if parts[0] == "scene":
                 _, check, what = self.scene_keys[parts[1]]
-                for v in dict(self.axes(cfg))[key]:
+                for v in values:
                     if not check(v):
                         raise ConfigError(f"config key grid.{key}: {v!r} is not valid: {what}")
             if parts[0] == "fluids" and (len(parts) != 3 or parts[1] not in fluids):
@@ -182,12 +182,10 @@ class SceneFlow(Flow):
                 axes = tuple((k, v) for (k, _), v in zip(own, values))
                 out += [Case(float(dp), float(ch), sh, scheme=scheme, fluid=fl, axes=axes)
                         for scheme in g["scheme"] for sh in g["shifting"] for ch in g["ch"] for dp in g["dp"]]
-        ids = [c.id for c in out]
-        dup = sorted({i for i in ids if ids.count(i) > 1})
-        if dup:
-            raise ConfigError(f"config key grid: two axes give the same case id(s) {', '.join(dup)}: "
-                              "give them keys whose last parts differ")
-        return out
+        try:
+            return unique(out, "give the grid's axes keys whose last parts differ")
+        except ValueError as exc:
+            raise ConfigError(f"config key grid: {exc}") from None
 
     @staticmethod
     def case_config(cfg: dict, case: Case) -> dict:
@@ -196,11 +194,7 @@ class SceneFlow(Flow):
             return cfg
         cfg = copy.deepcopy(cfg)
         for key, value in case.axes:
-            node = cfg
-            parts = key.split(".")
-            for p in parts[:-1]:
-                node = node[p]
-            node[parts[-1]] = value
+            set_key(cfg, key, value)
         return cfg
 
     def case_dict(self, cfg: dict, case: Case) -> dict:
@@ -257,11 +251,8 @@ class SceneFlow(Flow):
         coords = {"case": [c.id for c in cs], "dp": ("case", [c.dp for c in cs]),
                   "ch": ("case", [c.ch for c in cs]), "shifting": ("case", [c.shifting for c in cs]),
                   "scheme": ("case", [c.scheme for c in cs]), "fluid": ("case", [c.fluid or "" for c in cs])}
-        for key, _ in self.axes(cfg):  # a physical axis: its value, NaN (or "") where a case has none
-            values = [dict(c.axes).get(key) for c in cs]
-            numeric = all(isinstance(v, (int, float)) or v is None for v in values)
-            coords[axis_label(key)] = ("case", [(math.nan if v is None else float(v)) if numeric
-                                                else ("" if v is None else str(v)) for v in values])
+        for key, _ in self.axes(cfg):  # a physical axis: each case's value
+            coords[axis_label(key)] = ("case", axis_values(cs, key))
         data = {k: ("case", [float(m[k]) if k in m else math.nan for m in rows]) for k in names}
         data["status"] = ("case", [m.attrs["status"] for m in rows])
         data["reason"] = ("case", [m.attrs["reason"] for m in rows])
