@@ -5,7 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import Rect, Scene
+from .layout import laid_walls, lattice, profile_lattice
+from .scene import Scene
 
 FLUID, BOUNDARY = 0, 1
 
@@ -19,8 +20,8 @@ class Particles:
     u: np.ndarray
     w: np.ndarray
     rho: np.ndarray
-    mass: np.ndarray  # rho(t=0) dp dz: particle volumes match the lattice cells
-    cell_volume: np.ndarray  # dp dz, the lattice cell (dp^2 but in a profile with row_depth)
+    mass: np.ndarray  # rho(t=0) dx dz: particle volumes match the lattice cells
+    cell_volume: np.ndarray  # dx dz, the lattice cell (solver/layout.py; dp^2 where sizes divide dp)
     kind: np.ndarray  # int8: 0 fluid, 1 boundary
     wall: np.ndarray  # int32: wall index, -1 for fluid
     gx: np.ndarray  # ghost node of a boundary particle
@@ -32,16 +33,6 @@ class Particles:
         return self.x.size
 
 
-def lattice(rect: Rect, dp: float) -> tuple[np.ndarray, np.ndarray]:
-    """Points of the dp lattice inside rect, offset dp/2 from its edges."""
-    nx = int(round((rect.x[1] - rect.x[0]) / dp))
-    nz = int(round((rect.z[1] - rect.z[0]) / dp))
-    xs = rect.x[0] + (np.arange(nx) + 0.5) * dp
-    zs = rect.z[0] + (np.arange(nz) + 0.5) * dp
-    X, Z = np.meshgrid(xs, zs, indexing="ij")
-    return X.ravel(), Z.ravel()
-
-
 def hydrostatic_density(scene: Scene, z: np.ndarray, top) -> np.ndarray:
     """Density of a Tait column at rest with free surface at ``top`` (bed-normal gravity g_n):
     dP/dz = -rho g_n with dP/drho = c0^2 (rho/rho0)^6 makes rho^6 linear in depth d,
@@ -51,37 +42,19 @@ def hydrostatic_density(scene: Scene, z: np.ndarray, top) -> np.ndarray:
     return rho0 * (1.0 + 6.0 * (-scene.gravity[1]) * d / (c0 * c0)) ** (1.0 / 6.0)
 
 
-def profile_lattice(profile, dp: float) -> tuple[np.ndarray, np.ndarray, float]:
-    """Lattice points of a profile region: columns dp/2 inside [x0, x1], rows dz apart from
-    base + dz/2 while below the surface (round((top - base) / dz) rows per column), and the
-    row spacing dz (``FluidProfile.row_spacing``)."""
-    dz = profile.row_spacing(dp)
-    nx = int(round((profile.x[1] - profile.x[0]) / dp))
-    xs = profile.x[0] + (np.arange(nx) + 0.5) * dp
-    tops = profile.top(xs)
-    X, Z = [], []
-    for x, top in zip(xs, tops):
-        n = int(np.floor((top - profile.base) / dz + 0.5))
-        if n > 0:
-            X.append(np.full(n, x))
-            Z.append(profile.base + (np.arange(n) + 0.5) * dz)
-    if not X:
-        return np.zeros(0), np.zeros(0), dz
-    return np.concatenate(X), np.concatenate(Z), dz
-
-
 def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None,
                 dz=None) -> np.ndarray:
     """Free-surface height above each query point: the top (+ dz/2) of the contiguous run of
-    fluid lattice points in its column that starts at or just above it.
+    fluid lattice points in the nearest fluid column (within dp / 2 of the query's x) that
+    starts at or just above it.
 
-    Fluid points are (x, z) with row spacings ``dz`` (default dp); queries default to the
-    fluid points themselves.
+    Fluid points are (x, z) with row spacings ``dz`` (default dp); points with the same x (to
+    1e-6 dp) form a column. Queries default to the fluid points themselves.
     """
     qx = x if qx is None else qx
     qz = z if qz is None else qz
     dz = np.full(x.size, dp) if dz is None else np.asarray(dz, dtype=float)
-    col = np.round(x / dp).astype(np.int64)
+    col = np.round(x / (1e-6 * dp)).astype(np.int64)
     order = np.lexsort((z, col))
     cs, zs = col[order], z[order]
     # top of each contiguous run (same column, gaps of at most 1.5 rows)
@@ -92,12 +65,18 @@ def column_tops(x: np.ndarray, z: np.ndarray, dp: float, qx=None, qz=None,
         if cs[i + 1] == cs[i] and zs[i + 1] - zs[i] < 1.5 * rows[i]:
             run_top[i] = run_top[i + 1]
     out = np.full(qx.size, -np.inf)
-    qcol = np.round(qx / dp).astype(np.int64)
+    keys = np.unique(cs)
+    key_x = keys * (1e-6 * dp)
     for k in range(qx.size):
-        lo = np.searchsorted(cs, qcol[k], side="left")
-        hi = np.searchsorted(cs, qcol[k], side="right")
-        if lo == hi:
+        m = int(np.searchsorted(key_x, qx[k]))
+        near = [j for j in (m - 1, m) if 0 <= j < keys.size]
+        if not near:
             continue
+        j_col = min(near, key=lambda j: abs(key_x[j] - qx[k]))
+        if abs(key_x[j_col] - qx[k]) > 0.5 * dp * (1.0 + 1e-9):
+            continue
+        lo = np.searchsorted(cs, keys[j_col], side="left")
+        hi = np.searchsorted(cs, keys[j_col], side="right")
         j = lo + np.searchsorted(zs[lo:hi], qz[k] - 0.5 * dp, side="left")
         if j < hi and zs[j] - qz[k] < 1.5 * dp:
             out[k] = run_top[j]
@@ -163,32 +142,35 @@ def ghost_node(px: float, pz: float, edges, walls, periodic, eps: float) -> tupl
 
 
 def build_particles(scene: Scene) -> Particles:
-    """Fill fluid regions and walls on the dp lattice.
+    """Fill fluid regions and walls (``layout``: fluid extents filled exactly, walls laid from
+    their fluid faces).
 
     Density starts hydrostatic (bed-normal gravity) below the local free surface of each
     column, for fluid and for the wall particles under it; each particle's mass is
-    rho dp dz so that m/rho is its lattice cell's volume (dz = dp but in a profile with
-    ``row_depth``).
+    rho dx dz so that m/rho is its lattice cell's volume.
     """
     dp = scene.dp
-    fx, fz, fu, fw, fdz = [], [], [], [], []
-    regions = [(b, (*lattice(b, dp), dp)) for b in scene.fluid.blocks] + [
+    fx, fz, fu, fw, fdx, fdz = [], [], [], [], [], []
+    regions = [(b, lattice(b, dp)) for b in scene.fluid.blocks] + [
         (p, profile_lattice(p, dp)) for p in scene.fluid.profiles]
-    for region, (x, z, dz) in regions:
-        fx.append(x), fz.append(z), fdz.append(np.full(x.size, dz))
+    for region, (x, z, dx, dz) in regions:
+        fx.append(x), fz.append(z), fdx.append(np.full(x.size, dx)), fdz.append(np.full(x.size, dz))
         fu.append(np.full(x.size, region.velocity[0])), fw.append(np.full(x.size, region.velocity[1]))
-    fx, fz, fdz = np.concatenate(fx), np.concatenate(fz), np.concatenate(fdz)
+    fx, fz, fdx, fdz = (np.concatenate(a) for a in (fx, fz, fdx, fdz))
     fu, fw = np.concatenate(fu), np.concatenate(fw)
     frho = hydrostatic_density(scene, fz, column_tops(fx, fz, dp, dz=fdz))
 
-    bx, bz, bwall = [], [], []
-    for i, w in enumerate(scene.walls):
-        x, z = lattice(w, dp)
+    walls = laid_walls(scene)
+    bx, bz, bwall, bdx, bdz = [], [], [], [], []
+    for i, lw in enumerate(walls):
+        x, z = lw.points()
         bx.append(x), bz.append(z), bwall.append(np.full(x.size, i, dtype=np.int32))
+        bdx.append(np.full(x.size, lw.dx)), bdz.append(np.full(x.size, lw.dz))
     if bx:
-        bx, bz, bwall = np.concatenate(bx), np.concatenate(bz), np.concatenate(bwall)
+        bx, bz, bwall, bdx, bdz = (np.concatenate(a) for a in (bx, bz, bwall, bdx, bdz))
     else:
-        bx, bz, bwall = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int32)
+        bx, bz, bdx, bdz = np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0)
+        bwall = np.zeros(0, dtype=np.int32)
     # wall particles under fluid: continue the column above the wall top
     wall_top = np.array([scene.walls[i].z[1] for i in bwall]) if bx.size else np.zeros(0)
     btop = column_tops(fx, fz, dp, bx, wall_top + 0.5 * dp, dz=fdz)
@@ -196,17 +178,18 @@ def build_particles(scene: Scene) -> Particles:
     gx = np.full(bx.size, np.nan)
     gz = np.full(bx.size, np.nan)
     eps = 1e-6 * dp
-    edges = _interface_edges(scene.walls, scene.fluid.extents(), scene.periodic_x, eps)
+    rects = [lw.rect for lw in walls]
+    edges = _interface_edges(rects, scene.fluid.extents(), scene.periodic_x, eps)
     for k in range(bx.size):
-        gx[k], gz[k] = ghost_node(bx[k], bz[k], edges, scene.walls, scene.periodic_x, eps)
+        gx[k], gz[k] = ghost_node(bx[k], bz[k], edges, rects, scene.periodic_x, eps)
 
     nf, nb = fx.size, bx.size
     return Particles(
         x=np.concatenate([fx, bx]), z=np.concatenate([fz, bz]),
         u=np.concatenate([fu, np.zeros(nb)]), w=np.concatenate([fw, np.zeros(nb)]),
         rho=np.concatenate([frho, brho]),
-        mass=np.concatenate([frho * fdz, brho * dp]) * dp,
-        cell_volume=np.concatenate([fdz * dp, np.full(nb, dp * dp)]),
+        mass=np.concatenate([frho * fdz * fdx, brho * bdz * bdx]),
+        cell_volume=np.concatenate([fdz * fdx, bdz * bdx]),
         kind=np.concatenate([np.full(nf, FLUID, np.int8), np.full(nb, BOUNDARY, np.int8)]),
         wall=np.concatenate([np.full(nf, -1, np.int32), bwall]),
         gx=np.concatenate([np.full(nf, np.nan), gx]), gz=np.concatenate([np.full(nf, np.nan), gz]),

@@ -13,6 +13,8 @@ from typing import Any, get_args, get_origin, get_type_hints
 import numpy as np
 import yaml
 
+from .layout import LayoutError, check_layout
+
 SHIFTING_METHODS = ("none", "skillen", "lind")
 # lind within 2h of the free surface: the paper's no shift, or the shift along the surface only
 NEAR_SURFACE = ("none", "tangential")
@@ -591,13 +593,19 @@ def validate(scene: Scene) -> None:
             raise SceneError(f"periodic_x: the period must hold at least 3 kernel supports (6 h = {6 * scene.h:g} m)")
         n = period / scene.dp
         if abs(n - round(n)) > 1e-6:
-            raise SceneError(f"periodic_x: the period {period:g} m must be a whole number of dp")
+            raise SceneError(f"periodic_x: the period {1e3 * period:.6g} mm is not a whole number of "
+                             f"particles at dp = {1e3 * scene.dp:.6g} mm ({n:.4g} of them); choose dp "
+                             f"dividing it")
         for r in scene.fluid.extents() + list(scene.walls):
             if r.x[0] < x0 - 1e-12 or r.x[1] > x1 + 1e-12:
                 raise SceneError(f"periodic_x: every block and wall must lie within {list(scene.periodic_x)}")
     if scene.domain is not None:
         _interval(scene.domain.x, "domain.x")
         _interval(scene.domain.z, "domain.z")
+    try:
+        check_layout(scene)
+    except LayoutError as exc:
+        raise SceneError(str(exc)) from None
     n = scene.estimated_particles()
     per_particle = BYTES_PER_PARTICLE
     if scene.implicit_viscosity:

@@ -55,8 +55,10 @@ def test_preset_geometry(start):
     assert area == pytest.approx(c.fluid_length * c.h_n ** 2, abs=0.5 * c.dp * initial_toe(c))
     assert p.x[f].min() > 0 and p.z[f].min() > 0
     assert p.x[f].max() < initial_toe(c)
-    if start == "block":
-        assert p.z[f].max() == pytest.approx(c.dp * (round(c.h_n / c.dp) - 0.5), abs=1e-12)
+    if start == "block":  # round(h_n / dp) rows filling h_n exactly (docs/scene.md, "Particle layout")
+        rows = round(c.h_n / c.dp)
+        assert p.z[f].max() == pytest.approx(c.h_n * (1 - 0.5 / rows), abs=1e-12)
+        assert area == pytest.approx(c.fluid_length * c.h_n ** 2, rel=1e-9)
 
 
 @pytest.mark.parametrize("r", [1.0, 0.9831])
