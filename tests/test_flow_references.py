@@ -211,6 +211,153 @@ def test_spreads_five_heights():
     assert not slump.spreads_five_heights(0.1, 0.1, 100.0, RHO, G)
 
 
+# ---- slump: the perfectly plastic layer beyond the lubrication limit -----------------------
+def plastic_force(h, tau: float) -> np.ndarray:
+    """int_0^h sigma_xx dz of the yielded layer at rest, by quadrature over z: the hydrostatic
+    part -rho g h^2 / 2 and twice the longitudinal deviatoric stress N = sqrt(tau^2 - T^2) left
+    by the shear T = tau (1 - z/h) at yield (von Mises in the plane), tensile (N > 0)."""
+    h = np.atleast_1d(np.asarray(h, dtype=float))
+    s = (np.arange(200_000) + 0.5) / 200_000
+    mean_n = np.mean(tau * np.sqrt(1.0 - (1.0 - s) ** 2))
+    return -RHO * G * h * h / 2.0 + 2.0 * mean_n * h
+
+
+def test_corrected_shape_solves_the_plastic_layers_balance():
+    """d/dx int_0^h sigma_xx dz = tau (the bed's shear at yield, the surface free), the depth
+    integral by quadrature of the stress (not the closed form pi / 2), the slope by finite
+    differences; and -h_x (h - pi l / 2) = l; a front step of pi l; nothing beyond the front."""
+    tau, xn = 20.0, 0.3
+    ell = tau / (RHO * G)
+    x = np.linspace(0.02, 0.98, 50) * xn  # the wall is a symmetry plane, a ridge
+    dx = 1e-6 * xn
+    h = slump.final_shape_corrected(x, xn, tau, RHO, G)
+    h_x = (slump.final_shape_corrected(x + dx, xn, tau, RHO, G)
+           - slump.final_shape_corrected(x - dx, xn, tau, RHO, G)) / (2 * dx)
+    assert np.allclose(-h_x * (h - math.pi * ell / 2), ell, rtol=1e-6)
+    dfdx = (plastic_force(slump.final_shape_corrected(x + dx, xn, tau, RHO, G), tau)
+            - plastic_force(slump.final_shape_corrected(x - dx, xn, tau, RHO, G), tau)) / (2 * dx)
+    assert np.allclose(dfdx, tau, rtol=1e-4)
+    assert slump.final_shape_corrected(xn, xn, tau, RHO, G) == pytest.approx(math.pi * ell)
+    assert slump.final_shape_corrected(xn * (1 + 1e-9), xn, tau, RHO, G) == 0.0
+    assert slump.front_distance_corrected(h, tau, RHO, G) == pytest.approx(xn - x, rel=1e-9, abs=1e-12)
+
+
+def test_corrected_shape_tends_to_the_lubrication_shape_at_first_order_in_l_over_h():
+    """h_corrected / h_shallow - 1 = (pi / 2) (l / h) + O((l / h)^2), at the same distance from
+    the front, the remainder (pi^2 / 8) (l / h)^2: it falls tenfold with l / h."""
+    tau = 10.0
+    ell = tau / (RHO * G)
+    rests = []
+    for depth in (10 * ell, 100 * ell, 1000 * ell):
+        xi = depth * depth / (2 * ell)  # where the lubrication shape is that deep
+        hs = float(slump.final_shape(0.0, xi, tau, RHO, G))
+        hc = float(slump.final_shape_corrected(0.0, xi, tau, RHO, G))
+        assert hs == pytest.approx(depth)
+        rest = (hc / hs - 1) / (ell / hs) - math.pi / 2
+        assert rest == pytest.approx(math.pi ** 2 / 8 * ell / hs, rel=0.1)
+        rests.append(rest)
+    assert rests[1] / rests[0] == pytest.approx(0.1, rel=0.1)
+    assert rests[2] / rests[1] == pytest.approx(0.1, rel=0.02)
+
+
+def test_corrected_runout_falls_short_of_the_lubrication_one_by_pi_over_4_wall_depths():
+    """All yielded, x_N(lubrication) - x_N(corrected) = (pi / 4) h_w + (pi^2 / 32) l + O(l^2 / h_w),
+    h_w = (3 A l)^(1/3) the lubrication depth at the wall (the volume constraint expanded in
+    l / h_w): the O(l) coefficient is reached as l / h_w -> 0, the remainder over l / h_w
+    settling to a constant."""
+    H0, L0 = 0.1, 0.1
+    rests = []
+    for tau in (1.0, 0.1, 0.01):
+        ell = tau / (RHO * G)
+        hw = (3 * H0 * L0 * ell) ** (1 / 3)
+        gap = slump.release_runout(H0, L0, tau, RHO, G) - slump.release_runout_corrected(H0, L0, tau, RHO, G)
+        rest = (gap - math.pi / 4 * hw) / ell - math.pi ** 2 / 32
+        assert abs(rest) < 3 * ell / hw
+        rests.append(rest / (ell / hw))
+    assert rests[0] == pytest.approx(rests[2], rel=0.02)
+    assert rests[1] == pytest.approx(rests[2], rel=0.01)
+
+
+@pytest.mark.parametrize("H0, L0, tall", [(0.1, 0.1, True), (0.05, 0.1, True), (0.02, 0.5, False),
+                                          (0.008, 0.2, False)])
+def test_corrected_release_runout_holds_the_release(H0, L0, tall):
+    """The arrested shape min(H0, final_shape_corrected) through the corrected runout holds the
+    release's area (midpoint quadrature, the front step included), fully yielded where tall and
+    with a plateau at H0 otherwise."""
+    tau = 20.0
+    xn = slump.release_runout_corrected(H0, L0, tau, RHO, G)
+    def shape(x):
+        return slump.release_shape_corrected(x, H0, L0, tau, RHO, G)
+    assert midpoint(shape, 0.0, xn) == pytest.approx(H0 * L0, rel=1e-6)
+    assert tall == (slump.final_shape_corrected(0.0, xn, tau, RHO, G) < H0 * (1 - 1e-9))
+    assert L0 < xn < slump.release_runout(H0, L0, tau, RHO, G)
+
+
+def test_corrected_release_runout_is_continuous_where_the_plateau_appears():
+    """At L0 = area(H0) / H0 the release just yields at the wall: both branches give the front
+    distance of the depth H0; a release no higher than the front step pi l stays put."""
+    tau, H0 = 20.0, 0.05
+    ell = tau / (RHO * G)
+    L0 = slump._area_corrected(H0, tau, RHO, G) / H0
+    for length in (L0 * (1 - 1e-9), L0 * (1 + 1e-9)):
+        assert slump.release_runout_corrected(H0, length, tau, RHO, G) == pytest.approx(
+            float(slump.front_distance_corrected(H0, tau, RHO, G)), rel=1e-7)
+    assert slump.release_runout_corrected(math.pi * ell, 0.1, tau, RHO, G) == 0.1
+    assert slump.release_runout_corrected(math.pi * ell * (1 + 1e-7), 0.1, tau, RHO, G) == pytest.approx(0.1, rel=1e-5)
+
+
+def test_corrected_runout_of_the_shipped_release_and_its_front_rule():
+    """config/slump.yaml's release (H0 = 50 mm, L0 = 100 mm, tau_y = 17 Pa, rho = 1383):
+    261.0 mm against 282.1 mm in the lubrication limit. Cutting the shape at its vertical tangent
+    h = pi l / 2 instead of the step pi l (there the shape is the lubrication one raised by pi l / 2,
+    x_N - x = (h - pi l / 2)^2 / (2 l), whose area pi l x_N / 2 + (2/3) sqrt(2 l) x_N^(3/2) = A is
+    solved here on its own) moves the front by less than 2 l, 1.4 mm."""
+    H0, L0, tau, rho = 0.05, 0.1, 17.0, 1383.0
+    ell = tau / (rho * G)
+    xn = slump.release_runout_corrected(H0, L0, tau, rho, G)
+    assert xn == pytest.approx(0.26095, abs=5e-6)
+    assert slump.release_runout(H0, L0, tau, rho, G) == pytest.approx(0.28208, abs=5e-6)
+    lo, hi = L0, 1.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        area = math.pi * ell * mid / 2 + (2 / 3) * math.sqrt(2 * ell) * mid ** 1.5
+        lo, hi = (mid, hi) if area < H0 * L0 else (lo, mid)
+    assert 0 < lo - xn < 2 * ell
+    assert lo - xn == pytest.approx(1.36e-3, abs=0.05e-3)
+
+
+def test_slump_yield_scores_the_runout_against_the_corrected_reference():
+    """A run arrested on the corrected shape (particles on a dp lattice under it, both sides,
+    unchanged over 1 s) stops, has a runout error within dp / x_N of the corrected reference and
+    a small shape error; the lubrication runout comes beside it, 8 % farther."""
+    import xarray as xr
+
+    from study.flows import scores
+    H0, L0, tau, rho, dp = 0.05, 0.1, 17.0, 1383.0, 1e-3
+    xn = slump.release_runout_corrected(H0, L0, tau, rho, G)
+    xc = np.arange(dp / 2, xn, dp)
+    xc = xc[xc + dp / 2 <= xn + 1e-12]
+    px, pz = [], []
+    for x in xc:
+        h = float(slump.release_shape_corrected(x, H0, L0, tau, rho, G))
+        zc = np.arange(dp / 2, h, dp)
+        px += [x] * zc.size + [-x] * zc.size
+        pz += list(zc) * 2
+    n, times = len(px), np.linspace(0.0, 1.0, 21)
+    frames = {"x": np.tile(px, (times.size, 1)), "z": np.tile(pz, (times.size, 1)), "u": np.zeros((times.size, n))}
+    data = {k: (("snapshot", "particle"), v) for k, v in frames.items()}
+    data["kind"] = (("snapshot", "particle"), np.zeros((times.size, n), dtype=np.int8))
+    run = xr.Dataset(data, coords={"snapshot_time": ("snapshot", times)}, attrs={"dp": dp})
+    s = scores.slump_yield(run, H0, L0, tau, rho, stop_speed=2e-3, window=0.5)
+    assert s["stopped"] == 1.0
+    assert s["runout_reference"] == pytest.approx(xn)
+    assert s["runout_reference_shallow"] == pytest.approx(slump.release_runout(H0, L0, tau, rho, G))
+    assert s["runout_reference_shallow"] / s["runout_reference"] - 1 == pytest.approx(0.081, abs=0.001)
+    assert abs(s["runout_error"]) <= dp / xn
+    assert s["runout_error"] == pytest.approx(s["runout"] / xn - 1)
+    assert s["shape_error"] < 0.03
+
+
 # ---- film: start-up from rest -------------------------------------------------------------
 H, NU, THETA = 2e-3, 1e-4, math.radians(10.0)
 

@@ -93,28 +93,31 @@ def stop_time(t, x, stop_speed: float, window: float) -> float:
 
 
 def slump_yield(ds, H0: float, L0: float, tau_y: float, rho: float, stop_speed: float, window: float) -> dict:
-    """Whether the front stops (``stop_time``), its runout where it stops against the
-    lubrication runout (``slump.release_runout``), and the last snapshot's depth against the
-    arrested shape of the release (``slump.release_shape``) (RMS over 40 abscissas x <= 0.95 x_N, over its depth at
-    the wall). The runout's se: the front's scatter over the stop window."""
+    """Whether the front stops (``stop_time``), its runout where it stops against the reference
+    runout, that of the perfectly plastic layer (``slump.release_runout_corrected``), and the
+    last snapshot's depth against its arrested shape (``slump.release_shape_corrected``) (RMS over
+    40 abscissas x <= 0.95 x_N, over its depth at the wall). The runout's se: the front's scatter
+    over the stop window. ``runout_reference_shallow`` is the lubrication runout
+    (``slump.release_runout``): its difference from ``runout_reference`` is the reference's own
+    uncertainty, reported beside the error and not added to it."""
     xf = measure.front(ds, symmetric=True)
     t, x = xf["t"].values, xf.values
-    x_lub = slump.release_runout(H0, L0, tau_y, rho, G)
+    x_ref = slump.release_runout_corrected(H0, L0, tau_y, rho, G)
     t_s = stop_time(t, x, stop_speed, window)
-    out = {"runout_reference": x_lub, "front_final": float(x[-1]), "stop_time": t_s,
-           "stopped": float(np.isfinite(t_s))}
+    out = {"runout_reference": x_ref, "runout_reference_shallow": slump.release_runout(H0, L0, tau_y, rho, G),
+           "front_final": float(x[-1]), "stop_time": t_s, "stopped": float(np.isfinite(t_s))}
     if np.isfinite(t_s):
         k = int(np.argmin(np.abs(t - t_s)))
         sel = (t > t_s - window - 1e-12) & (t <= t_s)
         from solver.steady import line_fits
         _, se, _, _ = line_fits(t[sel], x[sel][None, :])
-        out |= {"runout": float(x[k]), "runout_error": float(x[k] / x_lub - 1.0),
-                "runout_error_se": float(se[0] / x_lub)}
+        out |= {"runout": float(x[k]), "runout_error": float(x[k] / x_ref - 1.0),
+                "runout_error_se": float(se[0] / x_ref)}
     else:
         out |= {"runout": math.nan, "runout_error": math.nan, "runout_error_se": math.nan}
     k = ds.sizes["snapshot"] - 1
-    xs = np.linspace(0.0, 0.95 * x_lub, 40)
-    h_ref = slump.release_shape(xs, H0, L0, tau_y, rho, G)
+    xs = np.linspace(0.0, 0.95 * x_ref, 40)
+    h_ref = slump.release_shape_corrected(xs, H0, L0, tau_y, rho, G)
     h_run = user.on_reference(xs, *measure.depth_profile(ds, k, symmetric=True))
     err, se = rms_with_se(xs, (h_run - h_ref) / h_ref[0])
     return out | {"shape_error": err, "shape_error_se": se}

@@ -1,6 +1,7 @@
 """The slump (docs/flow-slump.md): a two-sided release [-L0, L0] x [0, H0] on a no-slip bed,
 its front against Huppert's similarity solution (Newtonian) or its arrested shape and runout
-against the lubrication limit (yield stress)."""
+against those of a perfectly plastic layer, with the lubrication runout as the reference's own
+uncertainty (yield stress)."""
 from __future__ import annotations
 
 import html
@@ -45,20 +46,25 @@ class Slump(SceneFlow):
         nu = (fl.get("viscosity") or fl.get("consistency")) / fl["density"]
         return 0.2 * float(theory.front_position(1.0, s["height"] * s["length"], nu, G))
 
-    def reference_runout(self, cfg: dict, fluid: dict) -> float:
+    def reference_runout(self, cfg: dict, fluid: dict, shallow: bool = False) -> float:
         """The farthest front the reference predicts by the end time: the similarity front
-        (Newtonian) or the lubrication runout (yield stress)."""
+        (Newtonian) or the runout of the perfectly plastic layer (yield stress;
+        ``theory.release_runout_corrected``), with ``shallow`` the lubrication runout
+        (``theory.release_runout``), the reference's uncertainty."""
         s = cfg["scene"]
         H0, L0 = s["height"], s["length"]
         if newtonian(fluid):
             return float(theory.front_position(s["end_time"], H0 * L0, fluid["viscosity"] / fluid["density"], G))
-        return theory.release_runout(H0, L0, fluid["yield_stress"], fluid["density"], G)
+        runout = theory.release_runout if shallow else theory.release_runout_corrected
+        return runout(H0, L0, fluid["yield_stress"], fluid["density"], G)
 
     def scene(self, cfg: dict, case: Case) -> dict:
         s = cfg["scene"]
         H0, L0, dp = s["height"], s["length"], case.dp
         fl = self.fluid_of(cfg, case)
-        X = s["bed_length"] or max(1.3 * self.reference_runout(cfg, fl), 2.0 * L0)
+        # the farther of the yield-stress runouts (the lubrication one) sets the bed
+        X = s["bed_length"] or max(1.3 * self.reference_runout(cfg, fl),
+                                   1.3 * self.reference_runout(cfg, fl, shallow=True), 2.0 * L0)
         X = dp * math.ceil(X / dp)
         layers = 3 * dp * max(1, math.ceil(case.ch / 1.5))  # the wall covers the 2h support
         fl["blocks"] = [{"x": [-L0, L0], "z": [0.0, H0]}]
@@ -112,11 +118,20 @@ class Slump(SceneFlow):
                     "against ln t over the same snapshots; depth profile: the last snapshot, RMS over x &le; 0.95 x_N "
                     "over the reference's depth at the plane.</li>")
             else:
-                ratio = self.reference_runout(cfg, fl) / s["height"]
+                x_ref = self.reference_runout(cfg, fl)
+                x_lub = self.reference_runout(cfg, fl, shallow=True)
+                ell = theory.yield_length(fl["yield_stress"], fl["density"], G)
                 lines.append(
-                    f"<li><b>{html.escape(name)}</b> (tau_y = {fl['yield_stress']:.4g} Pa): the arrested shape "
-                    "of the lubrication limit, h^2 = 2 tau_y (x_N - x) / (rho g), and its runout "
-                    f"x_N = {1000 * self.reference_runout(cfg, fl):.4g} mm ({ratio:.2f} H0 from the plane). "
+                    f"<li><b>{html.escape(name)}</b> (tau_y = {fl['yield_stress']:.4g} Pa, "
+                    f"l = tau_y / (rho g) = {1000 * ell:.3g} mm): "
+                    "the arrested shape of a perfectly plastic layer yielded throughout, h^2 - pi l h = 2 l (x_N - x) "
+                    "(the lubrication balance with the layer's longitudinal plastic stress, right to second "
+                    "order in l / h; after Dubash et al., J. Non-Newtonian Fluid Mech. 158, 2009), cut at its "
+                    f"front step h = pi l, and its runout x_N = {1000 * x_ref:.1f} mm "
+                    f"({x_ref / s['height']:.2f} H0 from the plane). The lubrication limit, h^2 = 2 l (x_N - x), "
+                    f"runs out to {1000 * x_lub:.1f} mm: the difference, {1000 * (x_lub - x_ref):.1f} mm "
+                    f"({100 * (x_lub / x_ref - 1):.2g} % of the reference), is the reference's own uncertainty, "
+                    "reported here and not added to the runout error. "
                     f"The front has stopped once its speed, fitted over {cfg['metrics']['stop_window']:g} s, "
                     f"stays below {1000 * cfg['metrics']['stop_speed']:.3g} mm/s (the regularised fluid "
                     "creeps at about tau_y h / mu_max); the runout is the front then.</li>")
@@ -124,13 +139,16 @@ class Slump(SceneFlow):
 
     def front_figure(self, cfg: dict) -> str | None:
         return ("x_N(t) of every run; Newtonian: against the similarity front (log axes; dotted: t_c, "
-                "where the comparison starts); yield stress: against the lubrication runout.")
+                "where the comparison starts); yield stress: against the runout of the plastic layer "
+                "(dashed) and the lubrication runout (dotted), their difference the reference's uncertainty.")
 
     def front_reference(self, ax, cfg: dict, fluid: dict, ds: xr.Dataset, name: str) -> None:
         from .scene_figures import plain_log
         s = cfg["scene"]
         if not newtonian(fluid):
             ax.axhline(1000 * self.reference_runout(cfg, fluid), color="k", ls="--", lw=1.5,
+                       label="plastic-layer runout")
+            ax.axhline(1000 * self.reference_runout(cfg, fluid, shallow=True), color="0.4", ls=":", lw=1.5,
                        label="lubrication runout")
             return
         t = ds["front_time"].values
