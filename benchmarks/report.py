@@ -25,6 +25,7 @@ BENCHMARKS = [
     ("window_metrics", ["--calibrate"], True),
     ("paper_grid", [], True),
     ("viscous_limit", [], False),
+    ("viscous_limit", ["--forms"], False),
     ("acoustic_edge", [], True),
     ("slurm_local.sh", ["--check"], False),
 ]

@@ -55,6 +55,7 @@ SLOT_GROUPS = (
     # consistent laminar term: sum_b V_b gradW_ab, div r with m/rho, the normaliser N
     ("laminar_correction", ("VGX", "VGZ", "VDIVR", "NORM")),
     ("velocity_gradient", ("DUX", "DUZ", "DWX", "DWZ")),  # sum_b V_b (u_b - u_a) gradW_ab
+    ("stress_transpose", ("TX", "TZ")),  # div of nu (grad u)^T, sum_b V_b (S_b - S_a) . gradW_ab
     ("strain_correction", ("LAPG", "SUPP")),  # Laplacian of the last strain rate, the support
     ("volume", ("VOLC",)),  # the volume relaxation's concentration sum_b V_b W_ab
     ("implicit", ("DIAG",)),  # the diagonal sum_b c_ab of the implicit laminar system
@@ -70,6 +71,7 @@ class PairOptions(NamedTuple):
     packing: int = 0
     laminar_correction: bool = False  # the consistent, normalised laminar term's sums
     rheology: int = 0  # 0 one viscosity, 1 each particle's nu_p, 2 and the strain rate's Laplacian
+    stress: bool = False  # with rheology: the divergence of the stress form's transpose term
     artificial: bool = False  # Monaghan's artificial viscosity
     implicit_walls: float = 0.0  # > 0: list the fluid pairs and sum the implicit diagonal
 
@@ -78,6 +80,7 @@ class PairOptions(NamedTuple):
         return {"always": True, "packing": self.packing >= 1,
                 "laminar_correction": self.laminar_correction,
                 "velocity_gradient": self.laminar_correction or self.rheology >= 1,
+                "stress_transpose": self.stress and self.rheology >= 1,
                 "strain_correction": self.rheology == 2, "volume": self.packing == 2,
                 "implicit": self.implicit_walls > 0.0}
 
@@ -161,6 +164,11 @@ class PairFields(NamedTuple):
     cell: np.ndarray  # lattice cell dp dz of each particle (read with shifting only)
     irho: np.ndarray  # 1 / rho of each particle (``pressure_and_inverse_density``)
     vscale: np.ndarray  # each particle's laminar-term factor (read with viscous_scale only)
+    # the last transpose stress S_ij = nu d_i u_j (read with the stress form only)
+    sxx: np.ndarray
+    sxz: np.ndarray
+    szx: np.ndarray
+    szz: np.ndarray
 
 
 class PairConstants(NamedTuple):
@@ -299,7 +307,10 @@ def make_pair_loop(options: PairOptions):
     normaliser N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)) into NORM, and each pair's laminar term
     times the mean of its two particles' factors ``f.vscale`` (a fluid-wall pair's by the fluid
     particle's). rheology: each pair's viscosity from the particles' nu_p (``pair_viscosity``) and
-    the velocity gradient into DUX..DWZ (``rheology``); at 2 also the Laplacian
+    the velocity gradient into DUX..DWZ (``rheology``); with stress also the divergence of the
+    last transpose stress S = nu (grad u)^T (``f.sxx`` .. ``f.szz``), sum_b V_b (S_b - S_a) . gradW_ab
+    over fluid pairs, into TX, TZ (``add_stress_transpose``);
+    at 2 also the Laplacian
     2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate g = ``f.gamma`` into LAPG
     and the support sum_b V_b (-F r^2) / 2 into SUPP, over fluid pairs. artificial: Monaghan's
     artificial viscosity (all pairs, walls included, as DualSPHysics). implicit_walls > 0: the
@@ -310,12 +321,14 @@ def make_pair_loop(options: PairOptions):
     laminar_correction, artificial, implicit_walls = o.laminar_correction, o.artificial, o.implicit_walls
     implicit = implicit_walls > 0.0
     velocity_gradient = laminar_correction or rheology >= 1
+    stress = o.stress and rheology >= 1
     sl = slot_layout(o)
     NQ = sl.nq
     ZERO = (0.0,) * NQ  # a's running sums, one per slot
     GCX, GCZ, DIVR, WNX, WNZ, DIVDR = sl.GCX, sl.GCZ, sl.DIVR, sl.WNX, sl.WNZ, sl.DIVDR
     VGX, VGZ, VDIVR, NORM = sl.VGX, sl.VGZ, sl.VDIVR, sl.NORM
     DUX, DUZ, DWX, DWZ = sl.DUX, sl.DUZ, sl.DWX, sl.DWZ
+    TX, TZ = sl.TX, sl.TZ
     LAPG, SUPP, VOLC, DIAG = sl.LAPG, sl.SUPP, sl.VOLC, sl.DIAG
 
     @nb.njit(cache=True, fastmath=FASTMATH)
@@ -486,6 +499,12 @@ def make_pair_loop(options: PairOptions):
                         s = add_pair(s, at, b, DUZ, -(Vb * du * F * dz), -(Va * du * F * dz))
                         s = add_pair(s, at, b, DWX, -(Vb * dw * F * dx), -(Va * dw * F * dx))
                         s = add_pair(s, at, b, DWZ, -(Vb * dw * F * dz), -(Va * dw * F * dz))
+                    if stress and ka + kb == 0:
+                        # (S_b - S_a) . gradW_ab for a; (S_a - S_b) . gradW_ba, the same, for b
+                        tx = ((f.sxx[b] - f.sxx[a]) * dx + (f.sxz[b] - f.sxz[a]) * dz) * F
+                        tz = ((f.szx[b] - f.szx[a]) * dx + (f.szz[b] - f.szz[a]) * dz) * F
+                        s = add_pair(s, at, b, TX, Vb * tx, Va * tx)
+                        s = add_pair(s, at, b, TZ, Vb * tz, Va * tz)
                     if rheology == 2 and ka + kb == 0:
                         lg = 2.0 * (f.gamma[a] - f.gamma[b]) * rdotg * inv_r2e
                         s = add_pair(s, at, b, LAPG, Vb * lg, -(Va * lg))
@@ -621,6 +640,49 @@ def correct_viscous_term(out, kind, nu, n, scale, sl):
         c = 2.0 * nu * scale[i]
         out[AX, i] -= c * (gx * out[sl.DUX, i] + gz * out[sl.DUZ, i])
         out[AZ, i] -= c * (gx * out[sl.DWX, i] + gz * out[sl.DWZ, i])
+
+
+@nb.njit(parallel=True, cache=True)
+def add_stress_transpose(out, kind, rho, rho0, n, sl):
+    """The stress form's second half (``numerics.viscous_form: stress``): with a variable
+    viscosity, div(2 mu D) = div(mu grad u) + div(mu (grad u)^T). The pair loop's laminar term
+    is the first part; this adds the second to each fluid particle,
+
+      a_i += (rho0 / rho_a) d_j S_ij,   S_ij = nu d_i u_j,
+
+    with d_j S_ij the pair loop's sum_b V_b (S_b - S_a)_ij d_j W_ab over fluid pairs (TX, TZ)
+    and S the last evaluation's (``store_stress_transpose``). Explicit and one evaluation behind,
+    like the viscosity: an implicit laminar update keeps it in the right-hand side. Returns the
+    largest fluid |a| afterwards (dt1)."""
+    part = np.zeros(REDUCE_CHUNKS)
+    for c in nb.prange(REDUCE_CHUNKS):
+        v = 0.0
+        for i in range(c * n // REDUCE_CHUNKS, (c + 1) * n // REDUCE_CHUNKS):
+            if kind[i] != 0:
+                continue
+            f = rho0 / rho[i]
+            out[AX, i] += f * out[sl.TX, i]
+            out[AZ, i] += f * out[sl.TZ, i]
+            v = max(v, out[AX, i] * out[AX, i] + out[AZ, i] * out[AZ, i])
+        part[c] = v
+    return math.sqrt(part.max())
+
+
+@nb.njit(parallel=True, cache=True)
+def store_stress_transpose(out, kind, nu_p, n, sl, sxx, sxz, szx, szz):
+    """S_ij = nu_a d_i u_j of each fluid particle, from this evaluation's velocity gradient
+    (DUX .. DWZ) and the viscosity it gives (``rheology.update_viscosity``), for the next
+    evaluation. nu times the strain rate is the fluid's stress over rho0, bounded by the
+    rheology even where nu itself jumps between the cap and the yielded values; zero for walls."""
+    for i in nb.prange(n):
+        if kind[i] != 0:
+            sxx[i] = sxz[i] = szx[i] = szz[i] = 0.0
+            continue
+        nu = nu_p[i]
+        sxx[i] = nu * out[sl.DUX, i]
+        sxz[i] = nu * out[sl.DWX, i]
+        szx[i] = nu * out[sl.DUZ, i]
+        szz[i] = nu * out[sl.DWZ, i]
 
 
 @nb.njit(parallel=True, cache=True)

@@ -22,6 +22,7 @@ BOUNDARY_METHODS = ("mdbc", "dbc")
 MDBC_VELOCITY = ("shepard", "corrected")
 DIFFUSION_REFERENCES = ("spec", "column")
 VISCOUS_UPDATES = ("explicit", "implicit", "substepped")
+VISCOUS_FORMS = ("laminar", "stress")
 CFL_RULES = ("fixed", "damping")
 MIN_DAMPED_CFL = 0.05  # the damping rule refuses a scene it would take below this acoustic C
 CH_RANGE = (1.0, 4.0)  # h / dp: below 1 a particle's support holds too few neighbours to be stable
@@ -187,6 +188,9 @@ class Numerics:
     # laminar term) or substepped (the same operator over the step by Runge-Kutta-Chebyshev
     # stages); the last two lift the viscous limit on dt (solver/implicit.py)
     viscous_update: str = "explicit"
+    # laminar: the pair term discretises div(mu grad u); stress: div(2 mu D), the laminar term
+    # plus div(mu (grad u)^T), explicit (forces.add_stress_transpose; differs only where mu varies)
+    viscous_form: str = "laminar"
     # Monaghan's artificial viscosity alpha (DualSPHysics' default 0.01); null: off
     artificial_viscosity: float | None = None
     # floor the fluid density at rho0 after each step: no negative pressure, no tensile clumping
@@ -511,6 +515,7 @@ def _validate_numerics(scene: Scene) -> None:
     _one_of(n.boundary, BOUNDARY_METHODS, "numerics.boundary")
     _one_of(n.mdbc_velocity, MDBC_VELOCITY, "numerics.mdbc_velocity")
     _one_of(n.viscous_update, VISCOUS_UPDATES, "numerics.viscous_update")
+    _one_of(n.viscous_form, VISCOUS_FORMS, "numerics.viscous_form")
     _one_of(n.density_diffusion_reference, DIFFUSION_REFERENCES, "numerics.density_diffusion_reference")
     if n.density_diffusion is not None and not n.density_diffusion >= 0:
         raise SceneError(f"numerics.density_diffusion: must be >= 0, got {n.density_diffusion}")

@@ -11,6 +11,7 @@ from .build import Particles, build_particles
 from .kernel import alpha_2d
 from .scene import MAX_SHIFT, SURFACE_THRESHOLD, Scene
 
+_STRESS = ("sxx", "sxz", "szx", "szz")  # the stress form's last transpose stress
 _SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx", "gz", "pid")
 _SHIFTING = ("cell_volume", "wnx", "wnz")  # read by the shifting sums alone
 _SHIFT = ("shift_dx", "shift_dz")  # the last shift, pending its density correction
@@ -81,6 +82,11 @@ class Simulation:
         # the last strain rate (strain_rate_correction; a placeholder otherwise)
         self.gamma_p = np.zeros(self.n if self.strain_correction else 1)
         self.implicit = s.implicit_viscosity
+        # the stress form's transpose term (nothing to add where the viscosity is one constant)
+        self.stress_form = self.variable_viscosity and num.viscous_form == "stress"
+        # its transpose stress S = nu (grad u)^T from the last evaluation (placeholders otherwise)
+        for name in _STRESS:
+            setattr(self, name, np.zeros(self.n if self.stress_form else 1))
         self.volume_relaxation = num.volume_relaxation or 0.0
         self.mdbc = num.boundary == "mdbc"
         self.cfl_acoustic = s.cfl_acoustic  # C of the acoustic limit (cfl_rule)
@@ -90,6 +96,7 @@ class Simulation:
             packing=2 if self.volume_relaxation > 0 else (1 if shifting_on else 0),
             laminar_correction=self.viscous_correction,
             rheology=(2 if self.strain_correction else 1) if self.variable_viscosity else 0,
+            stress=self.stress_form,
             artificial=bool(num.artificial_viscosity),
             implicit_walls=(2.0 if self.mdbc else 1.0) if self.implicit else 0.0)
         self.slots = forces.slot_layout(self.pair_options)
@@ -99,6 +106,7 @@ class Simulation:
         self.sorted_fields = (_SORTED + (_SHIFTING + _SHIFT if self.pair_options.packing else ())
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
+                              + (_STRESS if self.stress_form else ())
                               + (("viscous_scale",) if self.viscous_correction else ())
                               + (_IMPLICIT if self.implicit and not self.substeps else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
@@ -197,7 +205,8 @@ class Simulation:
         forces.pressure_and_inverse_density(self.rho, self.p, self.irho, self.B, self.rho0)
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
-                                   self.gamma_p, self.cell_volume, self.irho, self.viscous_scale)
+                                   self.gamma_p, self.cell_volume, self.irho, self.viscous_scale,
+                                   self.sxx, self.sxz, self.szx, self.szz)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
             # more pairs than the list holds: widen it and evaluate again
@@ -212,15 +221,26 @@ class Simulation:
                                         self.slots)
             # the factors of the next evaluation
             forces.viscous_scale_factors(self.out, self.kind, self.n_active, self.slots, self.viscous_scale)
+        if self.stress_form:  # the divergence of the last evaluation's transpose stress
+            self.amax = max(self.amax, forces.add_stress_transpose(
+                self.out, self.kind, self.rho, self.rho0, self.n_active, self.slots))
         if self.variable_viscosity:  # the viscosity of the next evaluation
             fl = s.fluid
             self.nu_max_now = rheology.update_viscosity(
                 self.out, self.kind, self.nu_p, self.n_active, self.rho0, fl.yield_stress,
                 fl.consistency, fl.index, fl.max_viscosity, fl.papanastasiou or 0.0, self.gamma_p,
                 rheology.SMOOTHING_KAPPA * self.h ** 2 if self.strain_correction else 0.0, self.slots)
+            self.store_stress_transpose()
         if self.shift_method != "none":
             self._correct_density()
         return ""
+
+    def store_stress_transpose(self) -> None:
+        """S = nu (grad u)^T of each fluid particle from this evaluation's gradient and nu_p,
+        for the next evaluation's stress form (``forces.store_stress_transpose``); nothing without it."""
+        if self.stress_form:
+            forces.store_stress_transpose(self.out, self.kind, self.nu_p, self.n_active, self.slots,
+                                          self.sxx, self.sxz, self.szx, self.szz)
 
     def _set_walls(self, t: float):
         """Wall particles' velocity (and, with mDBC, density) from the fluid at time t."""
@@ -378,8 +398,8 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFTING + _SHIFT + _IMPLICIT + ("nu_p", "gamma_p", "viscous_scale", "nu_max_now", "t", "steps",
-                                             "info", "dt_first", "n_active", "reason")
+    _STATE = _SORTED + _SHIFTING + _SHIFT + _IMPLICIT + _STRESS + (
+        "nu_p", "gamma_p", "viscous_scale", "nu_max_now", "t", "steps", "info", "dt_first", "n_active", "reason")
 
     def state(self) -> dict:
         """Everything needed to resume exactly where this simulation stands."""

@@ -63,6 +63,11 @@ def test_viscous_limit():
                  "u RMS error", "| 0.2 |")
 
 
+def test_viscous_forms_step_cost():
+    assert_table(run("benchmarks.viscous_limit", "--forms", "--quick", "--exact", "--steps", "5", "--threads", "1"),
+                 "| form | ms per step (median) | per round |", "| stress |")
+
+
 def test_acoustic_edge_predicts():
     assert_table(run("benchmarks.acoustic_edge", "--predict", "--only", "dp2.25-ch1.8-c0.60"),
                  "C / C*", "| dp2.25-ch1.8-c0.60 | 2.25 | 1.8 |")

@@ -52,12 +52,12 @@ def periodic_strip(name: str, width: float) -> dict:
             "walls": [{**w, "x": [0.0, width]} for w in d["walls"]], "periodic_x": [0.0, width]}
 
 
-def film_errors(name: str, width: float | None = None):
+def film_errors(name: str, width: float | None = None, **changes):
     """(L2 error of u over the plug velocity, largest deviation of a particle above the exact
     yield surface from the plug velocity, relative error of the computed plug thickness) of a
     Herschel-Bulkley film example at its end time (on a periodic strip ``width`` wide if
-    given, else the example's)."""
-    scene, z, u, gamma, nu = steady_state(name, **(periodic_strip(name, width) if width else {}))
+    given, else the example's; ``changes`` merged into the scene)."""
+    scene, z, u, gamma, nu = steady_state(name, **(periodic_strip(name, width) if width else {}), **changes)
     f = scene.fluid
     H = f.blocks[0].z[1]
     g_s = scene.gravity[0]
@@ -101,13 +101,16 @@ def test_power_law_channel():
 
 
 @pytest.mark.slow
-def test_herschel_bulkley_film():
+@pytest.mark.parametrize("form", ["laminar", "stress"])
+def test_herschel_bulkley_film(form):
     """Carbopol-like film (tau_y = 20 Pa, K = 10 Pa s^n, n = 0.4) on the 15.3 deg incline.
     Velocity: see HB_FILM_L2. Plug: every particle above the exact yield surface h0 moves
     within 1 % of the exact plug velocity (measured 0.77 % with the example's implicit
     viscosity at cfl 0.4, 0.75 % at cfl 0.2, 0.73 % explicit); the computed yield surface (where the particle stress
-    mu(gamma) gamma falls to tau_y) lies HB_FILM_YIELD above h0."""
-    err, plug_speed, plug_error = film_errors("hb_film")
+    mu(gamma) gamma falls to tau_y) lies HB_FILM_YIELD above h0. The same bounds hold with the
+    stress form, whose extra term vanishes in the exact film but not in its particle noise
+    (measured L2 2.53 %, plug 0.82 %)."""
+    err, plug_speed, plug_error = film_errors("hb_film", numerics={"viscous_form": form})
     assert err < HB_FILM_L2[1], (err, HB_FILM_L2)
     assert plug_speed < 0.01  # measured 0.0075
     assert abs(plug_error - HB_FILM_YIELD[0]) < HB_FILM_YIELD[1], plug_error
