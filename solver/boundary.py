@@ -25,6 +25,7 @@ import numpy as np
 from .cells import cell_of, column_window, neighbour_cell, neighbour_column
 from .forces import FASTMATH
 from .kernel import alpha_2d, grad_coefficient, grad_factor, kernel, w_value
+from .sources import variant_named
 
 DET_MIN = 1.0e-3  # on the matrix made dimensionless with h
 TANGENTIAL_MOMENT_MAX = 0.1  # h: the corrected ghost velocity fades out up to this lopsidedness
@@ -96,7 +97,6 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
     """Compile the mDBC update with the Shepard or the corrected ghost velocity; with
     ``no_penetration`` each boundary density is floored by ``number_density_floor``."""
 
-    @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
     def mdbc_update(x, z, u, w, rho, mass, kind, wall, gxs, gzs, vwall, cl, n_active, h, rho0, dp2, n_lattice):
         """Set density and no-slip velocity of every active boundary particle from its ghost.
 
@@ -215,4 +215,5 @@ def make_mdbc_update(corrected_velocity: bool, no_penetration: bool = False):
             u[i] = 2.0 * vwx - ug
             w[i] = 2.0 * vwz - wg
 
-    return mdbc_update
+    return nb.njit(parallel=True, cache=True, fastmath=FASTMATH)(
+        variant_named(mdbc_update, (corrected_velocity, no_penetration)))

@@ -21,7 +21,7 @@ class Particles:
     w: np.ndarray
     rho: np.ndarray
     mass: np.ndarray  # rho(t=0) dx dz: particle volumes match the lattice cells
-    cell_volume: np.ndarray  # dx dz, the lattice cell (solver/layout.py; dp^2 where sizes divide dp)
+    cell_volume: np.ndarray  # dx dz, the lattice cell (solver/layout.py; dp^2 where dp divides the sizes)
     kind: np.ndarray  # int8: 0 fluid, 1 boundary
     wall: np.ndarray  # int32: wall index, -1 for fluid
     gx: np.ndarray  # ghost node of a boundary particle

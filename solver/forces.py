@@ -43,6 +43,7 @@ import numpy as np
 from numba.cpython.unsafe.tuple import tuple_setitem
 
 from .kernel import ETA2, alpha_2d, grad_coefficient, grad_factor, w_value
+from .sources import variant_named
 
 # ---- accumulator slots ------------------------------------------------------------------
 # The pair sums of particle i are acc[thread, i, slot]. A loop variant holds the groups whose
@@ -146,7 +147,7 @@ def thread_rows(start, split, t, ncx, ncz):
 class PairFields(NamedTuple):
     """Particle arrays the pair loop reads, in cell order. sdx, sdz: the last shift (read
     only with the shifting density correction); wnx, wnz: inward wall normals; cell: each
-    particle's lattice cell dp dz (the volume the shifting's concentration counts)."""
+    particle's lattice cell dx dz (the volume the shifting's concentration counts)."""
     x: np.ndarray
     z: np.ndarray
     u: np.ndarray
@@ -161,7 +162,7 @@ class PairFields(NamedTuple):
     sdz: np.ndarray
     nu_p: np.ndarray  # each particle's kinematic viscosity (read with variable_viscosity only)
     gamma: np.ndarray  # each particle's last strain rate (read with strain_correction only)
-    cell: np.ndarray  # lattice cell dp dz of each particle (read with shifting only)
+    cell: np.ndarray  # lattice cell dx dz of each particle (read with shifting only)
     irho: np.ndarray  # 1 / rho of each particle (``pressure_and_inverse_density``)
     vscale: np.ndarray  # each particle's laminar-term factor (read with viscous_scale only)
     # the last transpose stress S_ij = nu d_i u_j (read with the stress form only)
@@ -277,7 +278,7 @@ def diffusion_column(g, drab, dz, inv_rsum, rho0, k_col):
 
 @nb.njit(inline="always", cache=True)
 def concentration_terms(F, dx, dz, rdotg):
-    """gradW_ab and -r_ab . gradW_ab: times c_b (b's lattice cell dp dz) they are a's shares of
+    """gradW_ab and -r_ab . gradW_ab: times c_b (b's lattice cell dx dz) they are a's shares of
     gradC = sum_b c_b gradW_ab and div r = -sum_b c_b r_ab . gradW_ab; times c_a, b's shares
     (gradC's with the opposite sign)."""
     return F * dx, F * dz, -rdotg
@@ -331,7 +332,6 @@ def make_pair_loop(options: PairOptions):
     TX, TZ = sl.TX, sl.TZ
     LAPG, SUPP, VOLC, DIAG = sl.LAPG, sl.SUPP, sl.VOLC, sl.DIAG
 
-    @nb.njit(cache=True, fastmath=FASTMATH)
     def thread_pairs(t, f, cl, split, k, acc, pair_i, pair_j, pair_k):
         """Thread t's share of ``pair_loop``: acc[t, i, :] = the pair sums of the particles of
         its columns and of the next column; returns (max h |u_ab . r_ab| / (r^2 + eta^2), the
@@ -520,6 +520,8 @@ def make_pair_loop(options: PairOptions):
                     at[a, q] += s[q]
         return vm, npl
 
+    thread_pairs = nb.njit(cache=True, fastmath=FASTMATH)(variant_named(thread_pairs, options))
+
     def pair_loop(f, cl, split, k, acc, vmax, pair_i, pair_j, pair_k, pair_count):
         """acc[t, i, :] = the pair sums of the particles thread t writes (``PairFields`` f,
         ``cells.CellList`` cl, ``PairConstants`` k); vmax[t] = max h |u_ab . r_ab| / (r^2 + eta^2);
@@ -537,7 +539,7 @@ def make_pair_loop(options: PairOptions):
     # loop would be compiled afresh in every process.
     pair_loop = types.FunctionType(pair_loop.__code__, dict(globals(), _thread_pairs=thread_pairs),
                                    pair_loop.__name__, None, pair_loop.__closure__)
-    return nb.njit(parallel=True, cache=True)(pair_loop)
+    return nb.njit(parallel=True, cache=True)(variant_named(pair_loop, options))
 
 
 @nb.njit(cache=True)

@@ -2,7 +2,7 @@
 
 Fluid blocks and profile columns fill their stated extent exactly: n = round(L / dp) particles
 L / n apart along each side (``stretched_points``), so the fluid's area is the scene's whatever
-dp is. Each wall is laid from its faces towards the fluid: the layer nearest a face that fluid
+dp is. Each wall is laid from its fluid faces, away from the fluid: the layer nearest a face that fluid
 lies beyond sits dp / 2 inside it, hence dp from the fluid lattice of a block that touches the
 face (within dp / (4n) of it), and layers go on away from the fluid for the stated thickness or
 for the kernel support 2h, whichever is deeper (``laid_walls``). Where every size is a whole
@@ -35,7 +35,7 @@ def stretched_points(lo: float, hi: float, dp: float) -> tuple[np.ndarray, float
     """n = round((hi - lo) / dp) points (hi - lo) / n apart, the first half a spacing inside lo,
     and that spacing: the interval is filled exactly, its spacing within dp (1 +- 1 / (2n)); dp
     itself, bit for bit, where the length is a whole number of dp. n = 0 when the length is
-    under dp / 2 (``laid_scene`` refuses such a block or wall)."""
+    dp / 2 or less (``check_layout`` refuses such a block or wall)."""
     n = int(round((hi - lo) / dp))
     if n < 1:
         return np.zeros(0), dp
@@ -98,8 +98,9 @@ def fluid_sides(wall, fluid: list, periodic) -> dict[int, tuple[bool, bool]]:
 
 @dataclass(frozen=True)
 class LaidWall:
-    """A wall's particle region ``rect`` (the stated one, grown away from the fluid where it is
-    thinner than 2h) and its columns ``xs`` and rows ``zs``, spacings ``dx`` and ``dz``."""
+    """A wall's particle region ``rect`` (the stated one, its far side moved to
+    max(round(T / dp), ceil(2h / dp)) dp from each fluid face, and its ends moved out to meet
+    grown walls) and its columns ``xs`` and rows ``zs``, spacings ``dx`` and ``dz``."""
 
     rect: Extent
     xs: np.ndarray
@@ -164,7 +165,7 @@ def laid_walls(scene) -> list[LaidWall]:
                 name = "x" if axis == 0 else "z"
                 raise LayoutError(
                     f"walls[{i}] ({w.name}): its {name} extent {1e3 * (hi - lo):.4g} mm holds no "
-                    f"particle at dp = {1e3 * dp:.4g} mm (it must be at least dp / 2)")
+                    f"particle at dp = {1e3 * dp:.4g} mm (it must be more than dp / 2)")
             pos.append(p)
             steps.append(step)
             spans.append(span)
@@ -195,7 +196,7 @@ def _meet_grown_walls(i, axis, lo, hi, walls, laid):
 
 def check_layout(scene) -> None:
     """Raise LayoutError, naming the block, profile or wall and dp, for a scene that cannot be laid out at its
-    dp: an extent that holds no particle (under dp / 2)."""
+    dp: an extent that holds no particle (dp / 2 or less)."""
     dp = scene.dp
     regions = [(f"fluid.blocks[{i}]", b) for i, b in enumerate(scene.fluid.blocks)] + [
         (f"fluid.profiles[{i}]", Extent(p.x, (0.0, 1.0))) for i, p in enumerate(scene.fluid.profiles)]
@@ -204,5 +205,5 @@ def check_layout(scene) -> None:
             if round((hi - lo) / dp) < 1:
                 raise LayoutError(
                     f"{key}: its {name} extent {1e3 * (hi - lo):.4g} mm holds no particle at "
-                    f"dp = {1e3 * dp:.4g} mm (it must be at least dp / 2)")
+                    f"dp = {1e3 * dp:.4g} mm (it must be more than dp / 2)")
     laid_walls(scene)

@@ -13,7 +13,7 @@ from typing import Any, get_args, get_origin, get_type_hints
 import numpy as np
 import yaml
 
-from .layout import LayoutError, check_layout
+from .layout import LayoutError, check_layout, laid_walls
 
 SHIFTING_METHODS = ("none", "skillen", "lind")
 # lind within 2h of the free surface: the paper's no shift, or the shift along the surface only
@@ -303,10 +303,9 @@ class Scene(YamlData):
         return 2.0 if s.method == "skillen" else 1.0
 
     def estimated_particles(self) -> int:
-        cell = self.dp * self.dp
-        n = (sum(b.area for b in self.fluid.blocks) + sum(p.area for p in self.fluid.profiles)
-             + sum(w.area for w in self.walls))
-        return int(round(n / cell))
+        """The fluid's area over dp^2 and the particles of the walls as laid (at least 2h deep)."""
+        fluid = sum(b.area for b in self.fluid.blocks) + sum(p.area for p in self.fluid.profiles)
+        return int(round(fluid / (self.dp * self.dp))) + sum(w.xs.size * w.zs.size for w in laid_walls(self))
 
 
 # ---- reading and validation -------------------------------------------------

@@ -31,6 +31,17 @@ def source_hash() -> str:
     return files_hash(sorted(Path(__file__).parent.glob("*.py")))
 
 
+def variant_named(fn, variant):
+    """``fn`` renamed after ``variant`` (its compile-time switches), before numba compiles it.
+    Numba keeps one cache index per function name and line; variants compiled from one
+    factory would share it, and two processes adding different variants at once can give
+    both the same data file, so that one later loads the other's machine code. A name per
+    variant gives each its own index."""
+    tag = hashlib.sha256(repr(variant).encode()).hexdigest()[:12]
+    fn.__qualname__ = f"{fn.__qualname__}_{tag}"
+    return fn
+
+
 def cache_base() -> Path:
     base = os.environ.get("SPH_SURGE_CACHE_DIR")
     if base:

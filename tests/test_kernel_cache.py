@@ -108,3 +108,22 @@ def test_a_second_process_loads_the_pair_loops_from_the_cache():
     pair_loops, probe = (int(v) for v in runs[1].stdout.split()[-2:])
     assert probe == 1, "the compile events were not seen"
     assert pair_loops == 0, "the second process compiled the pair loop again"
+
+
+def test_each_kernel_variant_has_its_own_cache_index():
+    """Variants compiled from one factory are named after their switches, so that numba gives
+    each its own cache index: two processes adding different variants to one index at once
+    could give both the same data file, and one would later load the other's machine code."""
+    from solver import boundary, forces
+    loops = [forces.make_pair_loop(forces.PairOptions(**o)) for o in
+             ({}, {"packing": 1}, {"rheology": 1}, {"rheology": 1, "stress": True})]
+    names = [d.py_func.__qualname__ for d in loops]
+    assert len(set(names)) == len(names) and all("pair_loop" in n for n in names)
+    updates = [boundary.make_mdbc_update(c, p) for c in (False, True) for p in (False, True)]
+    assert len({d.py_func.__qualname__ for d in updates}) == 4
+    # the same switches give the same name in every process, so the cache is found again
+    code = ("from solver import forces; print(forces.make_pair_loop(forces.PairOptions(rheology=1))"
+            ".py_func.__qualname__)")
+    again = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert again.stdout.strip() == names[2]
