@@ -15,7 +15,7 @@ import yaml
 from study import config as campaign_config
 from study import schema
 from study.flows import conveyor as cfgmod
-from study.grid import CASE_ID, case_id, expand, fmt
+from study.grid import CASE_ID, case_id, critical_paths, expand, fmt
 from study.metrics import case_metrics, rms_difference, zeta_f_error
 from study.reference import read_velocity_csv, theory
 
@@ -50,6 +50,24 @@ def test_grid_product_paper_and_extra_cases():
     kept = expand({**g, "exclude": [{"ch": 1.0, "shifting": "lind"}, {"dp": 0.0005, "ch": 1.8}]})
     assert {c.id for c in kept} == {"dp1mm_ch1_skillen", "dp1mm_ch1.8_skillen", "dp1mm_ch1.8_lind",
                                     "dp0.5mm_ch1_skillen"}
+
+
+def test_a_chain_of_warm_starts_is_scheduled_by_its_whole_length():
+    """The default campaign with warm starts: a coarse run that the finest waits on outranks
+    the finest start check, which waits on nothing; without warm starts the finest run first."""
+    c = load("config.yaml")
+    cases = cfgmod.cases(campaign_config.validate({**c, "warm_start": True}))
+    cost = lambda k: 1e-9 / k.dp ** 3  # noqa: E731
+    warm = critical_paths(cases, cost, lambda k: cfgmod.warm_source({**c, "warm_start": True}, k))
+    by_id = {k.id: k for k in cases}
+    assert warm["dp2.25mm_ch1.8_skillen"] == pytest.approx(cost(by_id["dp2.25mm_ch1.8_skillen"])
+                                                           + cost(by_id["dp1.5mm_ch1.8_skillen"]) + 1.0)
+    check = next(k for k in by_id if k.startswith("dp1mm") and "paper-start" in k)
+    assert warm["dp2.25mm_ch1.8_skillen"] > warm[check] == pytest.approx(1.0)
+    assert warm["dp2.25mm_ch1.3_skillen"] == pytest.approx(cost(by_id["dp2.25mm_ch1.3_skillen"])
+                                                           + cost(by_id["dp1.5mm_ch1.3_skillen"]))
+    cold = critical_paths(cases, cost, lambda k: None)
+    assert max(cold, key=cold.get).startswith("dp1mm") and cold["dp2.25mm_ch1.8_skillen"] < 0.1
 
 
 def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():

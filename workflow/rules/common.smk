@@ -6,7 +6,7 @@ import sys
 
 import yaml
 from study.config import validate as validate_campaign
-from study.grid import CASE_ID
+from study.grid import CASE_ID, critical_paths
 from study.layout import report_path, results_dir, run_path
 from study.registry import flow_of
 from study.schema import ConfigError
@@ -72,7 +72,12 @@ def warm_input(wildcards):
     return [run_path(config, src.id)] if src is not None else []
 
 
+# Each run's priority: its critical path, the cost ~ dp^-3 of the run and of the longest chain of
+# warm starts that waits on it, so that the longest chain starts first and the runs that wait on
+# nothing fill the other cores (without warm starts: finer runs first).
+RUN_PRIORITY = {k: round(v, 3) for k, v in critical_paths(
+    CASES, lambda c: 1e-9 / c.dp ** 3, lambda c: FLOW.warm_source(config, c)).items()}
+
+
 def run_priority(wildcards):
-    """Finer cases first (cost ~ dp^-3): the longest runs start at once, so that the cores
-    finish together instead of one long run starting last."""
-    return round(1e-9 / CASE_BY_ID[wildcards.case].dp ** 3, 3)
+    return RUN_PRIORITY[wildcards.case]

@@ -132,3 +132,22 @@ def axis_values(cases: list[Case], key: str) -> list:
     if all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in values):
         return [float("nan") if v is None else float(v) for v in values]
     return ["" if v is None else str(v) for v in values]
+
+
+def critical_paths(cases: list[Case], cost: Callable[[Case], float],
+                   source: Callable[[Case], Case | None]) -> dict[str, float]:
+    """Each case's critical path: its own ``cost`` plus the longest path among the cases that
+    start from it (``source(c)`` is the case c waits for, None for none). Scheduling the
+    longest path first lets a chain of warm starts run beside the runs that wait on nothing."""
+    waiting: dict[str, list[Case]] = {}
+    for c in cases:
+        s = source(c)
+        if s is not None:
+            waiting.setdefault(s.id, []).append(c)
+    paths: dict[str, float] = {}
+
+    def path(c: Case) -> float:
+        if c.id not in paths:
+            paths[c.id] = cost(c) + max((path(d) for d in waiting.get(c.id, [])), default=0.0)
+        return paths[c.id]
+    return {c.id: path(c) for c in cases}
