@@ -9,20 +9,104 @@ sum the pair contributions in another order, so round-off starts two runs of the
 apart, and a metric that moves less than between them is noise. A variant whose every metric
 lies within that spread of the case's is "equal" to it.
 
+With --campaign FILE it times whole campaigns instead: ``snakemake --cores --threads --configfile
+FILE --config name=STEM_VARIANT KEY=VALUE ...`` for each variant (its KEY=VALUE campaign keys,
+``case`` the file as given), one after the other, each under its own name (results/STEM_VARIANT/,
+never the campaign's own; with --reuse a variant whose folder holds a reduced campaign is read,
+not run again, and its wall time is not known). It prints each campaign's wall time, the span
+and the summed wall of its runs, how many are steady, how many start checks agree on every
+metric, and each run's averaging window, end and wall; the particle-steps summed over the runs
+are the campaign's work, which a busy host does not change.
+
     python -m benchmarks.time_to_solution [--case examples/conveyor_fast.yaml] [--shifting skillen lind]
         [--set KEY=VALUE ...] [--variant NAME KEY=VALUE ...] [--spread] [--threads 2] [--out DIR] [--reuse]
+    python -m benchmarks.time_to_solution --campaign config/config.yaml [--variant lubrication warm_start=false]
+        [--threads 2] [--reuse]
 """
 from __future__ import annotations
 
 import json
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 from benchmarks import common
 
 QUICK = {"shifting": ["skillen"], "sets": ["dp=0.004", "steady.max_time=1.5"]}
 
 
+def campaign_runs(folder: Path) -> list[dict]:
+    """Each run of a campaign's results folder: its case, start and end (unix s), window,
+    simulated end, wall and status."""
+    import xarray as xr
+    rows = []
+    for f in sorted(folder.glob("cases/*/run.nc")):
+        with xr.open_dataset(f) as ds:
+            a = ds.attrs
+            rows.append({"case": f.parent.name, "started": float(a.get("started_unix", float("nan"))),
+                         "ended": float(a.get("ended_unix", float("nan"))), "window": float(a["window_start_s"]),
+                         "end": float(a["simulated_time_s"]), "wall": float(a["wall_time_s"]),
+                         "steady": int(a["steady"]), "status": a["status"],
+                         "work": int(a["steps"]) * (int(a["n_fluid"]) + int(a["n_boundary"]))})
+    return rows
+
+
+def start_checks(folder: Path) -> tuple[int, int]:
+    """(start checks agreeing within 2 se on every metric, start checks) of a reduced campaign."""
+    import xarray as xr
+    from study import startcheck
+    with xr.open_dataset(folder / "campaign.nc") as ds:
+        t = startcheck.table(ds.load())
+    return int(t["agree"].all("metric").sum()), int(t.sizes["check"])
+
+
+def campaigns(a, variants: dict) -> int:
+    """The ``--campaign`` mode (module docstring)."""
+    stem = a.campaign.stem
+    rows, runs = [], {}
+    for name, sets in variants.items():
+        label = f"{stem}_{name}"  # never the campaign's own name: its results are the user's
+        folder = common.ROOT / "results" / label
+        wall = "-"
+        if not (a.reuse and (folder / "campaign.nc").exists()):
+            if folder.exists():
+                shutil.rmtree(folder)
+            cmd = [sys.executable, "-m", "snakemake", "--cores", str(a.threads), "--configfile", str(a.campaign),
+                   "--config", f"name={label}", *sets]
+            start = time.perf_counter()
+            res = subprocess.run(cmd, cwd=common.ROOT, capture_output=True, text=True)
+            wall = f"{time.perf_counter() - start:.0f}"
+            if res.returncode != 0:
+                print(res.stderr[-3000:], file=sys.stderr)
+                return res.returncode
+        runs[name] = campaign_runs(folder)
+        r = runs[name]
+        span = max(x["ended"] for x in r) - min(x["started"] for x in r)
+        agree, checks = start_checks(folder)
+        rows.append([name, " ".join(sets) or "-", wall, f"{span:.0f}", f"{sum(x['wall'] for x in r):.0f}",
+                     f"{sum(x['work'] for x in r) / 1e9:.2f}", f"{sum(x['steady'] for x in r)} of {len(r)}",
+                     f"{agree} of {checks}"])
+    print(f"campaign: {a.campaign.relative_to(common.ROOT) if a.campaign.is_relative_to(common.ROOT) else a.campaign}"
+          f"; {a.threads} cores")
+    print(common.table(["variant", "campaign keys", "wall [s]", "runs' span [s]", "runs' wall summed [s]",
+                        "G particle-steps", "steady", "start checks agreeing"], rows))
+    for name, r in runs.items():
+        print(f"\n{name}:")
+        print(common.table(["case", "averaging window from [s]", "ends at [s]", "wall [s]", "M particle-steps",
+                            "status"],
+                           [[x["case"], f"{x['window']:.2f}", f"{x['end']:.2f}", f"{x['wall']:.0f}",
+                             f"{x['work'] / 1e6:.0f}", x["status"]] for x in r]))
+    common.summary("; ".join(f"{row[0]}: {row[2]} s wall, runs over {row[3]} s, {row[5]} G particle-steps, "
+                             f"{row[6]} steady, start checks {row[7]}" for row in rows))
+    return 0
+
+
 def main(argv=None) -> int:
     ap = common.parser(__doc__, case="examples/conveyor_fast.yaml", out="time_to_solution")
+    ap.add_argument("--campaign", type=Path, default=None,
+                    help="time whole campaigns of this file instead (module docstring)")
     ap.add_argument("--shifting", nargs="+", default=["skillen", "lind"])
     ap.add_argument("--variant", nargs="+", action="append", default=[], metavar="NAME KEY=VALUE",
                     help="a variant: its name, then its overrides on top of the case's (repeatable)")
@@ -30,6 +114,9 @@ def main(argv=None) -> int:
     ap.add_argument("--reuse", action="store_true", help="keep the runs already in --out")
     a = common.parse(ap, argv, QUICK)
     variants = {"case": []} | {v[0]: v[1:] for v in a.variant}
+    if a.campaign is not None:
+        a.campaign = a.campaign.absolute()
+        return campaigns(a, variants)
     rows = []
     for method in a.shifting:
         def run(variant, threads, method=method):
