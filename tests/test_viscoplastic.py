@@ -123,3 +123,13 @@ def test_reference_for_a_yield_stress_fluid():
         inside = np.isfinite(u)
         mean = np.trapezoid(u[inside], z[inside]) / eta
         assert mean == pytest.approx(1.0, rel=0.02), s  # the z grid resolves the plug to 0.005 h_n
+
+
+def test_the_slopes_at_many_depths_are_the_slope_at_each():
+    """``driving_slopes`` (the front's thousands of depths at once) gives ``driving_slope`` at each
+    depth, for a Herschel-Bulkley and a Newtonian fluid, to round-off."""
+    from solver.viscoplastic import driving_slopes
+    for fluid in (HBFluid(1383.0, 10.0, 5.6, 0.6), HBFluid(1383.0, 0.0, 5.6, 1.0)):
+        h = np.linspace(0.05, 0.999, 40) * normal_depth(fluid, U_B, G, THETA)
+        one = np.array([driving_slope(fluid, x, U_B, G) for x in h])
+        np.testing.assert_allclose(driving_slopes(fluid, h, U_B, G), one, rtol=1e-12)
