@@ -39,12 +39,12 @@ def test_slurm_local_lists_what_it_needs():
 
 def test_report_writes_one_table(tmp_path):
     out = tmp_path / "RESULTS.md"
-    run("benchmarks.report", "--quick", "--only", "slurm_local.sh", "viscous_limit", "--output", str(out),
+    run("benchmarks.report", "--quick", "--only", "slurm_local.sh", "throughput", "--output", str(out),
         "--out", str(tmp_path))
     text = out.read_text()
     assert text.startswith("# Benchmark results")
     assert "| benchmark | command | date | host | wall [s] | figures |" in text
-    assert "| viscous_limit | `python -m benchmarks.viscous_limit --quick` |" in text
+    assert "| throughput | `python -m benchmarks.throughput --quick` |" in text
     assert "FAILED" not in text
 
 
