@@ -10,13 +10,13 @@ apart, and a metric that moves less than between them is noise. A variant whose 
 lies within that spread of the case's is "equal" to it.
 
 With --campaign FILE it times whole campaigns instead: ``snakemake --cores --threads --configfile
-FILE --config name=STEM_VARIANT KEY=VALUE ...`` for each variant (its KEY=VALUE campaign keys,
-``case`` the file as given), one after the other, each under its own name (results/STEM_VARIANT/,
-never the campaign's own; with --reuse a variant whose folder holds a reduced campaign is read,
-not run again, and its wall time is not known). It prints each campaign's wall time, the span
-and the summed wall of its runs, how many are steady, how many start checks agree on every
-metric, and each run's averaging window, end and wall; the particle-steps summed over the runs
-are the campaign's work, which a busy host does not change.
+FILE --config name=timing_STEM_VARIANT KEY=VALUE ...`` for each variant (its KEY=VALUE campaign
+keys, ``case`` the file as given), one after the other, each under its own name
+(results/timing_STEM_VARIANT/, replaced by each timing; with --reuse a variant whose folder
+holds a reduced campaign is read, not run again, and its wall time is not known). It prints
+each campaign's wall time, the span and the summed wall of its runs, how many are steady, how
+many start checks agree on every metric, and each run's averaging window, end and wall; the
+particle-steps summed over the runs are the campaign's work, which a busy host does not change.
 
     python -m benchmarks.time_to_solution [--case examples/conveyor_fast.yaml] [--shifting skillen lind]
         [--set KEY=VALUE ...] [--variant NAME KEY=VALUE ...] [--spread] [--threads 2] [--out DIR] [--reuse]
@@ -67,7 +67,7 @@ def campaigns(a, variants: dict) -> int:
     stem = a.campaign.stem
     rows, runs = [], {}
     for name, sets in variants.items():
-        label = f"{stem}_{name}"  # never the campaign's own name: its results are the user's
+        label = f"timing_{stem}_{name}"  # not a name a campaign takes: its folder is replaced
         folder = common.ROOT / "results" / label
         wall = "-"
         if not (a.reuse and (folder / "campaign.nc").exists()):
