@@ -37,29 +37,22 @@ from benchmarks import common
 QUICK = {"shifting": ["skillen"], "sets": ["dp=0.004", "steady.max_time=1.5"]}
 
 
-def campaign_runs(folder: Path) -> list[dict]:
-    """Each run of a campaign's results folder: its case, start and end (unix s), window,
-    simulated end, wall and status."""
-    import xarray as xr
-    rows = []
-    for f in sorted(folder.glob("cases/*/run.nc")):
-        with xr.open_dataset(f) as ds:
-            a = ds.attrs
-            rows.append({"case": f.parent.name, "started": float(a.get("started_unix", float("nan"))),
-                         "ended": float(a.get("ended_unix", float("nan"))), "window": float(a["window_start_s"]),
-                         "end": float(a["simulated_time_s"]), "wall": float(a["wall_time_s"]),
-                         "steady": int(a["steady"]), "status": a["status"],
-                         "work": int(a["steps"]) * (int(a["n_fluid"]) + int(a["n_boundary"]))})
-    return rows
-
-
-def start_checks(folder: Path) -> tuple[int, int]:
-    """(start checks agreeing within 2 se on every metric, start checks) of a reduced campaign."""
+def campaign_summary(folder: Path) -> tuple[list[dict], tuple[int, int]]:
+    """From a reduced campaign (its campaign.nc): each run's case, start and end (unix s),
+    window, simulated end, wall, work (particle-steps), steadiness and status; and (start
+    checks agreeing within 2 se on every metric, start checks)."""
     import xarray as xr
     from study import startcheck
     with xr.open_dataset(folder / "campaign.nc") as ds:
-        t = startcheck.table(ds.load())
-    return int(t["agree"].all("metric").sum()), int(t.sizes["check"])
+        ds = ds.load()
+    v = {k: ds[f"case_{k}"].values for k in ("started", "ended", "steady_state_time", "simulated_time",
+                                             "wall_time", "steps", "n_particles", "steady", "status")}
+    runs = [{"case": str(c), "started": v["started"][i], "ended": v["ended"][i],
+             "window": v["steady_state_time"][i], "end": v["simulated_time"][i], "wall": v["wall_time"][i],
+             "work": v["steps"][i] * v["n_particles"][i], "steady": int(v["steady"][i]), "status": str(v["status"][i])}
+            for i, c in enumerate(ds["case"].values)]
+    t = startcheck.table(ds)
+    return runs, (int(t["agree"].all("metric").sum()), int(t.sizes["check"]))
 
 
 def campaigns(a, variants: dict) -> int:
@@ -81,10 +74,9 @@ def campaigns(a, variants: dict) -> int:
             if res.returncode != 0:
                 print(res.stderr[-3000:], file=sys.stderr)
                 return res.returncode
-        runs[name] = campaign_runs(folder)
+        runs[name], (agree, checks) = campaign_summary(folder)
         r = runs[name]
         span = max(x["ended"] for x in r) - min(x["started"] for x in r)
-        agree, checks = start_checks(folder)
         rows.append([name, " ".join(sets) or "-", wall, f"{span:.0f}", f"{sum(x['wall'] for x in r):.0f}",
                      f"{sum(x['work'] for x in r) / 1e9:.2f}", f"{sum(x['steady'] for x in r)} of {len(r)}",
                      f"{agree} of {checks}"])
