@@ -41,18 +41,11 @@ class HBFluid:
         return self.n / (self.n + 1) * A * (h0 ** p - (h0 - np.minimum(z, h0)) ** p)
 
     def flux(self, h: float, S: float, g: float) -> float:
-        """q(h, S) of the module docstring."""
-        h0 = h - self.tau_y / (self.rho * g * S)
-        if h0 <= 0:
-            return 0.0
-        p = (self.n + 1) / self.n
-        A = (self.rho * g * S / self.K) ** (1 / self.n)
-        u_p = self.n / (self.n + 1) * A * h0 ** p
-        return u_p * (h - h0 / (p + 1))
+        """q(h, S) of the module docstring (``fluxes`` at one point)."""
+        return float(self.fluxes(np.float64(h), np.float64(S), g))
 
-    def fluxes(self, h: np.ndarray, S: np.ndarray, g: float) -> np.ndarray:
-        """``flux`` elementwise over arrays (numpy's vector power may round the last bit
-        differently)."""
+    def fluxes(self, h, S, g: float):
+        """q(h, S) of the module docstring, elementwise over arrays (0 where h <= the yield depth)."""
         h0 = h - self.tau_y / (self.rho * g * S)
         yielded = h0 > 0
         h0 = np.where(yielded, h0, 0.0)
@@ -73,17 +66,14 @@ def normal_depth(fluid: HBFluid, u_b: float, g: float, theta: float) -> float:
 
 
 def driving_slope(fluid: HBFluid, h: float, u_b: float, g: float) -> float:
-    """S(h): q(h, S) = u_b h (q grows with S, from 0 at S = tau_y / (rho g h))."""
-    lo = fluid.tau_y / (fluid.rho * g * h)
-    hi = max(2.0 * lo, 1e-6)
-    while fluid.flux(h, hi, g) < u_b * h:
-        hi *= 2.0
-    return bisect(lambda S: fluid.flux(h, S, g) - u_b * h, lo, hi)
+    """S(h): q(h, S) = u_b h (q grows with S, from 0 at S = tau_y / (rho g h)); ``driving_slopes``
+    at one depth."""
+    return float(driving_slopes(fluid, np.array([h], dtype=float), u_b, g)[0])
 
 
-def driving_slopes(fluid: HBFluid, h: np.ndarray, u_b: float, g: float) -> np.ndarray:
-    """``driving_slope`` at each depth of ``h``: the same brackets and halvings, all depths at once
-    (each stops where ``roots.bisect`` stops it), to within round-off of the flux."""
+def driving_slopes(fluid: HBFluid, h, u_b: float, g: float) -> np.ndarray:
+    """S at each depth of ``h``: from the bracket [tau_y / (rho g h), the first doubling of
+    max(2 lo, 1e-6) with q >= u_b h], halved as ``roots.bisect`` halves, all depths at once."""
     h = np.asarray(h, dtype=float)
     lo = fluid.tau_y / (fluid.rho * g * h)
     hi = np.maximum(2.0 * lo, 1e-6)

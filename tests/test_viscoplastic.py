@@ -125,11 +125,16 @@ def test_reference_for_a_yield_stress_fluid():
         assert mean == pytest.approx(1.0, rel=0.02), s  # the z grid resolves the plug to 0.005 h_n
 
 
-def test_the_slopes_at_many_depths_are_the_slope_at_each():
-    """``driving_slopes`` (the front's thousands of depths at once) gives ``driving_slope`` at each
-    depth, for a Herschel-Bulkley and a Newtonian fluid, to round-off."""
+def test_the_slopes_at_many_depths_solve_the_flux_balance():
+    """``driving_slopes`` (the front's thousands of depths at once): for a Newtonian fluid the
+    exact S = 3 mu u_b / (rho g h^2); for a Herschel-Bulkley fluid q(h, S) = u_b h, each to
+    round-off, and the one-depth ``driving_slope`` is the same."""
     from solver.viscoplastic import driving_slopes
-    for fluid in (HBFluid(1383.0, 10.0, 5.6, 0.6), HBFluid(1383.0, 0.0, 5.6, 1.0)):
-        h = np.linspace(0.05, 0.999, 40) * normal_depth(fluid, U_B, G, THETA)
-        one = np.array([driving_slope(fluid, x, U_B, G) for x in h])
-        np.testing.assert_allclose(driving_slopes(fluid, h, U_B, G), one, rtol=1e-12)
+    newt = HBFluid(1383.0, 0.0, 5.6, 1.0)
+    h = np.linspace(0.05, 0.999, 40) * normal_depth(newt, U_B, G, THETA)
+    np.testing.assert_allclose(driving_slopes(newt, h, U_B, G), 3 * 5.6 * U_B / (1383.0 * G * h * h), rtol=1e-11)
+    hb = HBFluid(1383.0, 10.0, 5.6, 0.6)
+    h = np.linspace(0.05, 0.999, 40) * normal_depth(hb, U_B, G, THETA)
+    S = driving_slopes(hb, h, U_B, G)
+    np.testing.assert_allclose(hb.fluxes(h, S, G), U_B * h, rtol=1e-11)
+    assert driving_slope(hb, h[7], U_B, G) == S[7]
