@@ -10,12 +10,12 @@ and a case then costs
     wall = start-up + T_sim / dt * N / rate
 
 with T_sim from --t-sim (T, METHOD=T or METHOD@DP_MM=T: the simulated time at which a run ends
-steady, the end of its hold-out window; a start check's METHOD is e.g. ``skillen-paper``, and
-falls back to the method's) and, as the upper bound, the case's steady.max_time. The defaults
-are where the default campaign's dp = 1 mm runs ended (T_SIM_MEASURED). A start
-check costs what its grid case does per simulated second. Realisations of an ensemble cost what
-their case does. --coarse-only measures the coarsest dp at every Ch and the
-finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at another Ch takes
+steady, the end of its hold-out window; a start check's METHOD is its method and start, e.g.
+``skillen-paper`` or ``skillen-film``, and falls back to the method's) and, as the upper bound,
+the case's steady.max_time. The defaults are where dp = 1 mm runs of the default campaign ended
+(T_SIM_MEASURED). A start check costs what its grid case does per simulated second.
+Realisations of an ensemble cost what their case does. --coarse-only measures the coarsest dp
+at every Ch and the finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at another Ch takes
 its paper-Ch run's dt, rate and N times their Ch ratio at the coarsest dp.
 
     python -m benchmarks.paper_grid [--config config/paper.yaml] [--threads 2] [--time 0.05] [--fine-time 0.02]
@@ -55,9 +55,11 @@ def grid_cases(cfg: dict, methods=None, coarsest: int | None = None, paper_ch_on
         key = (c.dp, c.ch, c.shifting)
         if c.realisation == 0:
             d = case_dict(cfg, c)
-            if d.get("start") == "warm":  # a campaign's warm start: run cold here
-                d["start"] = cfg["case"].get("start", "lubrication")
+            if d.get("start") == "warm":  # a campaign's warm start: run from the case's own start here
+                d.pop("start")
                 d.pop("warm_from", None)
+                if "start" in cfg["case"]:
+                    d["start"] = cfg["case"]["start"]
             out[key] = [d, 0]
         out[key][1] += 1
     return out
@@ -79,13 +81,16 @@ def measure(data: dict, sets, sim_time: float) -> dict:
 
 
 T_SIM = ["12.5"]  # s, every case: --t-sim's default before the entries below
-# the ends of the default campaign's dp = 1 mm runs (config/config.yaml, 2026-12-06)
-T_SIM_MEASURED = ["skillen=16.6", "lind=17.7", "skillen-paper=11.2", "lind-paper=11.3"]
+# where dp = 1 mm runs of the default campaign (config/config.yaml, 2026-12-06) ended: from the
+# paper's start (the grid's own start, and a paper-start check), and from the moving film (a
+# film-start check; Lind's was not steady by its max_time, 20 s)
+T_SIM_MEASURED = ["skillen=11.3", "lind=10.1", "skillen-paper=11.3", "lind-paper=10.1",
+                  "skillen-film=17.1", "lind-film=20"]
 
 
 def t_sim_of(specs, method: str, dp: float) -> float:
     """T_sim of a case from --t-sim entries: T, METHOD=T or METHOD@DP_MM=T, the most specific wins;
-    a start check's METHOD (``skillen-paper``) falls back to its method's entries."""
+    a start check's METHOD (``skillen-paper``, ``skillen-film``) falls back to its method's entries."""
     best, rank = 12.5, -1
     names = [method] + ([method.split("-")[0]] if "-" in method else [])
     for s in specs:
@@ -98,10 +103,11 @@ def t_sim_of(specs, method: str, dp: float) -> float:
     return best
 
 
-def start_checks(cfg: dict) -> list[tuple[float, float, str]]:
-    """(dp, ch, method) of the campaign's start checks (study.flows.conveyor.start_checks)."""
-    from study.flows.conveyor import START_CHECK_TAG, cases
-    return [(c.dp, c.ch, c.shifting) for c in cases(cfg) if c.tag == START_CHECK_TAG]
+def start_checks(cfg: dict) -> list[tuple[float, float, str, str]]:
+    """(dp, ch, method, start) of the campaign's start checks (study.flows.conveyor.start_checks),
+    the start ``paper`` or ``film``."""
+    from study.flows.conveyor import CHECK_STARTS, cases
+    return [(c.dp, c.ch, c.shifting, c.tag.split("-")[0]) for c in cases(cfg) if c.tag in CHECK_STARTS]
 
 
 def main(argv=None) -> int:
@@ -160,14 +166,14 @@ def main(argv=None) -> int:
         total, total_max = total + to_steady, total_max + to_max
         rows.append([f"{dp * 1e3:g}", f"{ch:g}", m, count, how, f"{dt:.3g}", f"{rate / 1e6:.2f}", f"{ts:g}",
                      f"{to_steady / 3600:.2f}", f"{max_time:g}", f"{to_max / 3600:.2f}"])
-    checks = [k for k in start_checks(cfg) if k in grid and (k in runs or (k[0], pch, k[2]) in runs)]
-    for dp, ch, m in checks:  # a start check: its grid case's cost per simulated second
+    checks = [k for k in start_checks(cfg) if k[:3] in grid and (k[:3] in runs or (k[0], pch, k[2]) in runs)]
+    for dp, ch, m, start in checks:  # a start check: its grid case's cost per simulated second
         own = runs.get((dp, ch, m)) or runs[(dp, pch, m)]
-        ts, max_time = t_sim_of(a.t_sim, f"{m}-paper", dp), float(grid[(dp, ch, m)][0]["steady"].get("max_time", 30))
+        ts, max_time = t_sim_of(a.t_sim, f"{m}-{start}", dp), float(grid[(dp, ch, m)][0]["steady"].get("max_time", 30))
         per_second = own["particles"] / (own["dt"] * own["rate"])
         to_steady, to_max = own["startup"] + min(ts, max_time) * per_second, own["startup"] + max_time * per_second
         total, total_max = total + to_steady, total_max + to_max
-        rows.append([f"{dp * 1e3:g}", f"{ch:g}", f"{m}, paper's start", 1, "as its grid case", f"{own['dt']:.3g}",
+        rows.append([f"{dp * 1e3:g}", f"{ch:g}", f"{m}, {start} start", 1, "as its grid case", f"{own['dt']:.3g}",
                      f"{own['rate'] / 1e6:.2f}", f"{ts:g}", f"{to_steady / 3600:.2f}", f"{max_time:g}",
                      f"{to_max / 3600:.2f}"])
     n_runs = sum(n for _, n in grid.values()) + len(checks)

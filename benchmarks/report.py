@@ -23,7 +23,7 @@ BENCHMARKS = [
     ("kernel_times", [], False),
     ("kernel_times", ["--departures", "--case", "examples/dambreak.yaml", "--speed", "1.06"], False),
     ("time_to_solution", [], True),
-    ("time_to_solution", ["--campaign", "config/config.yaml", "--variant", "lubrication", "warm_start=false"], True,
+    ("time_to_solution", ["--campaign", "config/config.yaml", "--variant", "cold", "warm_start=false"], True,
      ["--campaign", "tests/data/mini.yaml", "--variant", "warm", "warm_start=true"]),
     ("window_metrics", [], True),
     ("window_metrics", ["--calibrate"], True),

@@ -20,7 +20,7 @@ particle-steps summed over the runs are the campaign's work, which a busy host d
 
     python -m benchmarks.time_to_solution [--case examples/conveyor_fast.yaml] [--shifting skillen lind]
         [--set KEY=VALUE ...] [--variant NAME KEY=VALUE ...] [--spread] [--threads 2] [--out DIR] [--reuse]
-    python -m benchmarks.time_to_solution --campaign config/config.yaml [--variant lubrication warm_start=false]
+    python -m benchmarks.time_to_solution --campaign config/config.yaml [--variant cold warm_start=false]
         [--threads 2] [--reuse]
 """
 from __future__ import annotations

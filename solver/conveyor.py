@@ -196,6 +196,13 @@ def preset_numerics(case: "ConveyorCase") -> dict:
     return schemes.preset(case.scheme, case.belt.speed, case.newtonian, particles_across(case)).get("numerics", {})
 
 
+def cold_start(case: "ConveyorCase") -> str:
+    """The start shape of the case's scheme (``schemes.preset``, else the default): where a warm
+    start cannot load its source, the run starts this way instead."""
+    preset = schemes.preset(case.scheme, case.belt.speed, case.newtonian, particles_across(case))
+    return preset.get("start", ConveyorCase.start)
+
+
 def resolve_scheme(data: dict) -> dict:
     """The case data with its scheme's preset under it (``schemes.preset``); SceneError for
     an unknown scheme, a moved key or a shifting method set inside numerics."""

@@ -14,7 +14,7 @@ import xarray as xr
 from . import film_depth, film_fit, steady
 from .build import build_particles
 from .checkpoint import Checkpointer, run_key
-from .conveyor import ConveyorCase, build_scene, lubrication_velocity, scheme_fluid, start_offsets
+from .conveyor import ConveyorCase, build_scene, cold_start, lubrication_velocity, scheme_fluid, start_offsets
 from .output import to_dataset
 from .probes import C_SURFACE, FieldSampler, last_crossing, toe_position
 from .progress import ProgressFile, chain
@@ -377,12 +377,12 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None, progress=
         from . import warm as _warm
         try:
             state = _warm.load(case.warm_from)
-        except (OSError, ValueError) as exc:  # a diverged or missing source: start cold
-            warm_note = f"fallback to the lubrication start: {exc}"
+        except (OSError, ValueError) as exc:  # a diverged or missing source: the scheme's cold start
+            warm_note = f"fallback to the scheme's start ({cold_start(case)}): {exc}"
             if not quiet:
                 print(f"warning: warm start not possible, {warm_note}", file=sys.stderr)
     if state is None and warm_note:
-        case = replace(case, start="lubrication", warm_from=None)
+        case = replace(case, start=cold_start(case), warm_from=None)
     ckpt = None
     saved = None
     if checkpoint is not None:

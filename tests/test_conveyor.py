@@ -120,14 +120,14 @@ def test_fast_example_is_the_paper_case_with_the_shipped_scheme():
     with open(EXAMPLES / "conveyor_fast.yaml") as fh:
         fast_d = yaml.safe_load(fh)
     changed = {k for k in paper_d.keys() | fast_d.keys() if paper_d.get(k) != fast_d.get(k)}
-    assert changed == {"name", "shifting", "scheme", "steady"}
+    assert changed == {"name", "shifting", "scheme", "steady", "start"}
     assert {k: v for k, v in fast_d["steady"].items() if k != "max_time"} == \
         {k: v for k, v in paper_d["steady"].items() if k != "max_time"}
     assert fast_d["dp"] <= 1.0e-3
     fast = case_from_dict(fast_d)
     n = fast.numerics
-    assert (fast.scheme, fast.shifting, n.viscous_correction, fast.start_velocity) == \
-        ("surge", "skillen", True, "lubrication")
+    assert (fast.scheme, fast.shifting, n.viscous_correction, fast.start, fast.start_velocity) == \
+        ("surge", "skillen", True, "block", "rest")
     assert (n.cfl, n.viscous_update) == (0.6, "substepped")
     assert n.cfl_rule == "damping" and build_scene(fast).cfl_acoustic == 0.6  # the rule does not bind
     assert n.shifting.min_speed == pytest.approx(0.5 * fast.belt.speed)
@@ -281,7 +281,7 @@ def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
               steady={"max_time": 0.05, "average": 0.04}, probes={"interval": 0.004})
     ds = run_front(c)
     assert ds.attrs["status"] == "not_steady"
-    assert ds.attrs["warm_start"].startswith("fallback to the lubrication start")
+    assert ds.attrs["warm_start"].startswith("fallback to the scheme's start (lubrication)")  # spec's
     assert "diverged" in ds.attrs["warm_start"]
     assert "start: lubrication" in ds.attrs["case_yaml"]
 

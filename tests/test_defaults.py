@@ -110,8 +110,8 @@ def test_campaign_configs_set_only_what_differs_from_a_default(name):
     assert restated == []
 
 
-# what the scheme sets: the numerics block and the start's velocity (solver/schemes.py)
-SCHEME_KEYS = ("numerics", "start_velocity", "scheme")
+# what the scheme sets: the numerics block and the start (solver/schemes.py)
+SCHEME_KEYS = ("numerics", "start", "start_velocity", "scheme")
 
 
 def test_paper_config_pins_the_default_case():
@@ -135,16 +135,16 @@ def test_shipped_conveyor_files_take_the_scheme_from_the_default_preset(path):
 
 
 def test_a_campaign_with_an_empty_case_runs_the_default_campaigns_scheme():
-    """case: {} with config/config.yaml's grid gives every case file the same scheme and
-    numerics as config/config.yaml's; they differ only in the keys config.yaml sets outside
-    the scheme (the steady window, and the warm start's start and source)."""
+    """case: {} with config/config.yaml's grid and warm start gives every case file the same
+    scheme and numerics as config/config.yaml's; they differ only in the keys config.yaml sets
+    outside the scheme (the steady window, and the warm start's source under each campaign's name)."""
     cfg = cfgmod.load(ROOT / "config" / "config.yaml")
     raw = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    bare = cfgmod.validate({"case": {}, "grid": raw["grid"]})
+    bare = cfgmod.validate({"case": {}, "grid": raw["grid"], "warm_start": raw["warm_start"]})
     assert [c.id for c in conveyor.cases(bare)] == [c.id for c in conveyor.cases(cfg)]
     for case in conveyor.cases(cfg):
         ours = case_from_dict(conveyor.case_dict(cfg, case)).to_dict()
         theirs = case_from_dict(conveyor.case_dict(bare, case)).to_dict()
         differ = {k for k in ours.keys() | theirs.keys() if ours.get(k) != theirs.get(k)}
-        assert differ <= {"steady", "start", "warm_from"}, (case.id, differ)
+        assert differ <= {"steady", "warm_from"}, (case.id, differ)
         assert ours["scheme"] == "surge" and ours["numerics"] == theirs["numerics"]

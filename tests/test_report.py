@@ -156,13 +156,16 @@ def test_the_verdict_section_says_what_the_runs_start_from_and_which_scheme_they
     case = case_from_dict({"dp": 1e-3, "ch": 1.8, "shifting": "lind"})
     ds.attrs.update(schemes=case.scheme, starts=start_description(case))
     text = html.unescape(verdict_table(ds))
-    assert ("The runs start from the steady lubrication front at the scheme's own film depth, moving "
-            "with the film's velocity profile, the belt at full speed; their scheme, surge, departs") in text
+    assert ("The runs start from a block at rest at the normal depth, the belt ramped up from rest; "
+            "their scheme, surge, departs") in text
     assert 'href="../docs/numerics.md"' in text
-    paper = case_from_dict({"dp": 1e-3, "scheme": "spec", "start": "block"})
-    ds.attrs.update(schemes="spec", starts=start_description(paper))
-    assert "a block at rest at the normal depth, the belt ramped up from rest; their scheme, spec, is the paper's" \
-        in html.unescape(verdict_table(ds))
+    spec = case_from_dict({"dp": 1e-3, "scheme": "spec"})
+    ds.attrs.update(schemes="spec", starts=start_description(spec))
+    assert ("the steady lubrication front at the scheme's own film depth, the belt ramped up from rest; their "
+            "scheme, spec, is the paper's") in html.unescape(verdict_table(ds))
+    film = case_from_dict({"dp": 1e-3, "start": "lubrication", "start_velocity": "lubrication"})
+    assert start_description(film) == ("the steady lubrication front at the scheme's own film depth, moving "
+                                       "with the film's velocity profile, the belt at full speed")
 
 
 def test_the_convergence_table_lists_only_the_sequences_that_have_data():

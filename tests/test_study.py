@@ -13,7 +13,7 @@ import xarray as xr
 import yaml
 
 from study import config as campaign_config
-from study import schema
+from study import schema, startcheck
 from study.flows import conveyor as cfgmod
 from study.grid import CASE_ID, case_id, critical_paths, expand, fmt
 from study.metrics import case_metrics, rms_difference, zeta_f_error
@@ -86,7 +86,7 @@ def test_configs_validate_and_expand():
     # Ch 1.8 x both methods x 3 dp; skillen at Ch 1.3 and 2.2 on the two coarser; then the start checks
     assert len(cs) == 12 and [c.id for c in cs[10:]] == ["dp1mm_ch1.8_skillen_paper-start",
                                                          "dp1mm_ch1.8_lind_paper-start"]
-    assert all(c.overrides == cfgmod.PAPER_START for c in cs[10:])
+    assert all(c.overrides == startcheck.PAPER_START for c in cs[10:])
     cs = cs[:10]
     dps = sorted({c.dp for c in cs})
     assert dps[0] == 0.001 and dps[1] / dps[0] == pytest.approx(dps[2] / dps[1]) == 1.5  # constant ratio
@@ -94,6 +94,10 @@ def test_configs_validate_and_expand():
     paper = campaign_config.validate(load("paper.yaml"))
     cs = cfgmod.configured_cases(paper)
     assert len(cs) == 18 and len(cfgmod.cases(paper)) == 20
+    # paper.yaml starts as the paper does: its checks start from the moving film
+    assert [c.id for c in cfgmod.cases(paper)[18:]] == ["dp0.25mm_ch1.8_skillen_film-start",
+                                                        "dp0.25mm_ch1.8_lind_film-start"]
+    assert all(c.overrides == startcheck.FILM_START for c in cfgmod.cases(paper)[18:])
     assert {c.dp for c in cs} == {0.001, 0.0005, 0.00025}
     assert {c.ch for c in cs} == {1.0, 1.3, 1.5, 1.8, 2.2}
     assert {c.ch for c in cs if c.shifting == "lind"} == {1.8}

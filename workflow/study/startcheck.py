@@ -1,13 +1,30 @@
 """The start check: at the finest dp, each shifting method's run from the campaign's start beside
-the same case run from the paper's start (a block at rest, the belt ramped up from rest). Pure
-functions over the campaign dataset (study.campaign.build)."""
+the same case run from another start: the paper's (a block at rest, the belt ramped up from rest),
+or, where the campaign's run starts that way already, the moving film (the steady lubrication
+front with the film's velocity profile, the belt at full speed from t = 0). Pure functions over
+the campaign dataset (study.campaign.build)."""
 from __future__ import annotations
 
 import numpy as np
 import xarray as xr
 
-START_CHECK_TAG = "paper-start"  # the tag of a start check's case id
+from solver.schemes import FILM_START, PAPER_START
+
+# a start check's tag (the end of its case id) -> the case keys of its start, and the start in words
+CHECK_STARTS = {"paper-start": PAPER_START, "film-start": FILM_START}
+CHECK_START_WORDS = {
+    "paper-start": "the paper's start: a block at rest at the normal depth, the belt ramped up from rest",
+    "film-start": ("the film start: the steady lubrication front moving with the film's velocity profile, "
+                   "the belt at full speed from t = 0"),
+}
 Z = 2.0  # two runs agree on a metric where |difference| <= Z se of the difference
+
+
+def check_tag(start: str, start_velocity: str) -> str:
+    """The tag of the check for a run that starts this way: the paper's start, or the film's
+    where the run starts as the paper does."""
+    own = {"start": start, "start_velocity": start_velocity}
+    return "film-start" if own == PAPER_START else "paper-start"
 
 
 def metric_names(ds: xr.Dataset) -> list[str]:
@@ -24,31 +41,32 @@ def _values(ds: xr.Dataset, i: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def pairs(ds: xr.Dataset) -> list[tuple[int, int]]:
-    """(index of the campaign-start case, index of its paper-start check) in the case table."""
+    """(index of the campaign-start case, index of its start check) in the case table."""
     if "case_tag" not in ds:
         return []
     ids = list(ds["case"].values)
     out = []
     for i, tag in enumerate(ds["case_tag"].values):
-        if tag == START_CHECK_TAG:
-            base = ids[i][: -len(START_CHECK_TAG) - 1]
+        if tag in CHECK_STARTS:
+            base = ids[i][: -len(tag) - 1]
             if base in ids:
                 out.append((ids.index(base), i))
     return out
 
 
 def table(ds: xr.Dataset) -> xr.Dataset:
-    """Per start check (dim ``check``, named by its case) and metric: both runs' values and se,
-    the difference paper-start minus campaign-start with its se, and ``agree`` (|difference|
-    <= Z se; False where either is missing). Empty ``check`` dimension without checks."""
+    """Per start check (dim ``check``, named by its case; ``start``: its tag) and metric: both
+    runs' values and se (``own``, ``other``), the difference check minus campaign-start with its
+    se, and ``agree`` (|difference| <= Z se; False where either is missing). Empty ``check``
+    dimension without checks."""
     names = metric_names(ds)
     rows = pairs(ds)
-    data = {k: np.full((len(rows), len(names)), np.nan) for k in ("own", "own_se", "paper", "paper_se")}
+    data = {k: np.full((len(rows), len(names)), np.nan) for k in ("own", "own_se", "other", "other_se")}
     for r, (i, j) in enumerate(rows):
         data["own"][r], data["own_se"][r] = _values(ds, i)
-        data["paper"][r], data["paper_se"][r] = _values(ds, j)
-    diff = data["paper"] - data["own"]
-    diff_se = np.hypot(data["own_se"], data["paper_se"])
+        data["other"][r], data["other_se"][r] = _values(ds, j)
+    diff = data["other"] - data["own"]
+    diff_se = np.hypot(data["own_se"], data["other_se"])
     with np.errstate(invalid="ignore"):
         agree = np.isfinite(diff) & np.isfinite(diff_se) & (np.abs(diff) <= Z * diff_se)
     dims = ("check", "metric")
@@ -56,6 +74,7 @@ def table(ds: xr.Dataset) -> xr.Dataset:
     return xr.Dataset(
         {**{k: (dims, v) for k, v in data.items()}, "difference": (dims, diff), "difference_se": (dims, diff_se),
          "agree": (dims, agree), "steady": (("check",), np.array(both_steady, dtype=bool)),
-         "own_case": (("check",), np.array([str(ds["case"].values[i]) for i, _ in rows], dtype=str))},
+         "own_case": (("check",), np.array([str(ds["case"].values[i]) for i, _ in rows], dtype=str)),
+         "start": (("check",), np.array([str(ds["case_tag"].values[j]) for _, j in rows], dtype=str))},
         coords={"check": np.array([str(ds["case"].values[j]) for _, j in rows], dtype=str),
                 "metric": np.array(names, dtype=str)})

@@ -11,7 +11,7 @@ import xarray as xr
 
 from .. import layout
 from ..grid import Case, expand, matches, physical_axes, set_key
-from ..startcheck import START_CHECK_TAG
+from ..startcheck import CHECK_STARTS, check_tag
 from ..schema import ConfigError, checked
 from .base import Flow
 
@@ -87,30 +87,26 @@ def configured_cases(cfg: dict) -> list[Case]:
     return expand(cfg["grid"], cfg.get("extra_cases"), lambda *point: realisations(cfg, *point))
 
 
-PAPER_START = {"start": "block", "start_velocity": "rest"}  # a block at rest, the belt ramped from rest
-
-
 def start_checks(cfg: dict, found: list[Case]) -> list[Case]:
     """With ``start_check``: at the finest grid dp, for each shifting method, the grid case at the
-    Ch nearest grid.paper_ch run once more from the paper's start (``PAPER_START``), tagged
-    START_CHECK_TAG. None where the campaign's own cases start that way already."""
+    Ch nearest grid.paper_ch run once more from another start (``startcheck.check_tag``: the
+    paper's, or the moving film's where that case starts as the paper does), tagged with it."""
     grid = [c for c in found if c.on_grid and c.realisation == 0 and c.axes == base_axes(cfg)]
     if not cfg.get("start_check", True) or not grid:
         return []
+    from solver.conveyor import case_from_dict
+    from solver.scene import SceneError
     finest = min(c.dp for c in grid)
     paper_ch = float(cfg["grid"].get("paper_ch", 1.8))
     checks = []
     for sh in dict.fromkeys(c.shifting for c in grid if c.dp == finest):
         c = min((c for c in grid if c.dp == finest and c.shifting == sh), key=lambda c: (abs(c.ch - paper_ch), c.ch))
-        checks.append(Case(c.dp, c.ch, sh, START_CHECK_TAG, dict(PAPER_START), axes=c.axes))
-    from solver.conveyor import case_from_dict
-    from solver.scene import SceneError
-    try:
-        own = case_from_dict(case_dict(cfg, grid[0]))
-    except SceneError:  # validate() reports it, naming the case
-        own = None
-    if own is not None and all(getattr(own, k) == v for k, v in PAPER_START.items()):
-        return []
+        try:
+            own = case_from_dict(case_dict(cfg, c))
+        except SceneError:  # validate() reports it, naming the case
+            continue
+        tag = check_tag(own.start, own.start_velocity)
+        checks.append(Case(c.dp, c.ch, sh, tag, dict(CHECK_STARTS[tag]), axes=c.axes))
     taken = {c.id for c in found}
     return [c for c in checks if c.id not in taken]
 
@@ -282,7 +278,7 @@ class Conveyor(Flow):
         physics = [physics_of(case) for case in recorded]
         ds.attrs["schemes"] = ", ".join(sorted({case.scheme for case in recorded}))
         ds.attrs["starts"] = "; ".join(sorted({start_description(case) for case, c in zip(recorded, cs)
-                                               if c.tag != START_CHECK_TAG}))
+                                               if c.tag not in CHECK_STARTS}))
         mixed = [c.id for c, p in zip(cs, physics) if p != physics[0]]
         if mixed:  # each run was scored against its own theory; one h_n or slope would misstate them
             ds.attrs["physics_differ"] = (f"{', '.join(mixed)} differ in physics from {cs[0].id}: each run's "
