@@ -158,6 +158,22 @@ def test_a_case_of_only_dp_ch_and_shifting_runs_the_shipped_scheme():
     assert spec == bare_spec
 
 
+def test_surge_starts_as_the_paper_where_h_n_holds_15_particles_and_from_the_moving_film_below():
+    """h_n = 18.8 mm: 18.8 particles across at dp = 1 mm (a block at rest, the belt ramped), 8.3 at
+    2.25 mm (the moving film, the belt at full speed); spec keeps its film shape at rest, and a
+    Herschel-Bulkley fluid starts from its moving film at any dp."""
+    def start(**d):
+        c = case_from_dict({"ch": 1.8, "shifting": "skillen", **d})
+        return c.start, c.start_velocity, c.ramp_end
+    assert start(dp=1.0e-3) == ("block", "rest", pytest.approx(0.3))
+    assert start(dp=1.2e-3)[0] == "block" and start(dp=1.3e-3)[0] == "lubrication"  # h_n / 15 = 1.25 mm
+    assert start(dp=2.25e-3) == ("lubrication", "lubrication", 0.0)
+    assert start(dp=1.0e-3, scheme="spec") == ("lubrication", "rest", pytest.approx(0.3))
+    hb = {"density": 1000.0, "rheology": "herschel_bulkley", "yield_stress": 20.0, "consistency": 10.0,
+          "index": 0.4, "max_viscosity": 100.0}
+    assert start(dp=1.0e-3, **hb) == ("lubrication", "lubrication", 0.0)
+
+
 def test_a_preset_key_is_overridden_by_the_case_and_old_flat_keys_say_where_they_live():
     c = paper(numerics={"cfl": 0.3})
     assert c.numerics.cfl == 0.3 and c.numerics.cfl_rule == "fixed"  # the rest stays spec's

@@ -216,12 +216,12 @@ def test_an_observed_order_above_4_is_flagged_and_not_extrapolated():
         assert all(c.endswith("&ndash;") for c in cells[5:8]), row
 
 
-def start_check_campaign(shift: float) -> xr.Dataset:
-    """A case table of a grid run at dp = 1 mm and its start check (tag paper-start), whose
-    zeta_h is ``shift`` above the grid run's (every se 0.0005)."""
+def start_check_campaign(shift: float, tag: str = "paper-start") -> xr.Dataset:
+    """A case table of a grid run at dp = 1 mm and its start check (``tag``), whose zeta_h is
+    ``shift`` above the grid run's (every se 0.0005)."""
     st = np.array([0.76, 1.5, 9.7])
-    ids = ["dp1mm_ch1.8_skillen", "dp1mm_ch1.8_skillen_paper-start"]
-    ds = xr.Dataset({"case_tag": ("case", ["", "paper-start"]), "case_steady": ("case", [1, 1]),
+    ids = ["dp1mm_ch1.8_skillen", f"dp1mm_ch1.8_skillen_{tag}"]
+    ds = xr.Dataset({"case_tag": ("case", ["", tag]), "case_steady": ("case", [1, 1]),
                      "case_zeta_u": (("case", "station"), np.full((2, 3), 0.01)),
                      "case_zeta_u_se": (("case", "station"), np.full((2, 3), 0.0005))},
                     coords={"case": ids, "station": st})
@@ -247,3 +247,17 @@ def test_the_start_check_sets_both_starts_side_by_side_and_says_whether_they_agr
     assert "<b>differ</b> on 1 of 6 metrics by more than 2 se (zeta_h): a real difference" in text
     assert "0.2 %" in text
     assert start_check_section(start_check_campaign(0.0).isel(case=[0])) == ""
+
+
+def test_a_film_start_check_is_paired_and_named_by_its_start():
+    """A campaign that starts as the paper does is checked from the moving film: the check
+    pairs with its grid run by its own tag, and the report says which start it ran from."""
+    from study import startcheck
+    from study.report import start_check_section
+    tab = startcheck.table(start_check_campaign(0.001, "film-start"))
+    assert list(tab["check"].values) == ["dp1mm_ch1.8_skillen_film-start"]
+    assert list(tab["start"].values) == ["film-start"] and bool(tab["agree"].all())
+    text = html.unescape(start_check_section(start_check_campaign(0.001, "film-start")))
+    assert "(from the film start: the steady lubrication front moving with the film's velocity profile" in text
+    assert "the paper's start: a block" not in text
+    assert startcheck.table(start_check_campaign(0.001, "other-start")).sizes["check"] == 0
