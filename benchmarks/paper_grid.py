@@ -15,8 +15,8 @@ steady, the end of its hold-out window; a start check's METHOD is its method and
 the case's steady.max_time. The defaults are where dp = 1 mm runs of the default campaign ended
 (T_SIM_MEASURED). A start check costs what its grid case does per simulated second.
 Realisations of an ensemble cost what their case does. --coarse-only measures the coarsest dp
-at every Ch and the finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at another Ch takes
-its paper-Ch run's dt, rate and N times their Ch ratio at the coarsest dp.
+at every Ch and the finer dp at the paper Ch (grid.paper_ch, else the middle Ch); a finer case at
+another Ch takes its paper-Ch run's dt, rate and N times their Ch ratio at the coarsest dp.
 
     python -m benchmarks.paper_grid [--config config/paper.yaml] [--threads 2] [--time 0.05] [--fine-time 0.02]
         [--t-sim 12.5 lind=16.5 skillen@0.25=10] [--shifting skillen lind] [--coarsest N] [--paper-ch-only]
@@ -81,9 +81,9 @@ def measure(data: dict, sets, sim_time: float) -> dict:
 
 
 T_SIM = ["12.5"]  # s, every case: --t-sim's default before the entries below
-# where dp = 1 mm runs of the default campaign (config/config.yaml, 2026-12-06) ended: from the
-# paper's start (the grid's own start, and a paper-start check), and from the moving film (a
-# film-start check; Lind's was not steady by its max_time, 20 s)
+# where the dp = 1 mm runs of config/config.yaml ended (2026-12-06): from the paper's start (its
+# start checks; the grid's own start at that dp, and a paper-start check) and from the moving film
+# (the campaign without warm starts; a film-start check; Lind's not steady by its max_time, 20 s)
 T_SIM_MEASURED = ["skillen=11.3", "lind=10.1", "skillen-paper=11.3", "lind-paper=10.1",
                   "skillen-film=17.1", "lind-film=20"]
 
