@@ -11,7 +11,7 @@ and a case then costs
 
 with T_sim from --t-sim (T, METHOD=T or METHOD@DP_MM=T: the simulated time at which a run ends
 steady, the end of its hold-out window; a start check's METHOD is its method and start, e.g.
-``skillen-paper`` or ``skillen-film``, and falls back to the method's) and, as the upper bound,
+``skillen-paper``, ``skillen-warm`` or ``skillen-film``, and falls back to the method's) and, as the upper bound,
 the case's steady.max_time. The defaults are where dp = 1 mm runs of the default campaign ended
 (T_SIM_MEASURED). A start check costs what its grid case does per simulated second.
 Realisations of an ensemble cost what their case does. --coarse-only measures the coarsest dp
@@ -82,15 +82,16 @@ def measure(data: dict, sets, sim_time: float) -> dict:
 
 T_SIM = ["12.5"]  # s, every case: --t-sim's default before the entries below
 # where the dp = 1 mm runs of config/config.yaml ended (2026-12-06): from the paper's start (its
-# start checks; the grid's own start at that dp, and a paper-start check) and from the moving film
-# (the campaign without warm starts; a film-start check; Lind's not steady by its max_time, 20 s)
+# start checks; the grid's own start at that dp, and a paper-start check), warm from dp = 1.5 mm
+# (its grid runs; a warm-start check) and from the moving film (the campaign without warm starts;
+# a film-start check; Lind's not steady by its max_time, 20 s)
 T_SIM_MEASURED = ["skillen=11.3", "lind=10.1", "skillen-paper=11.3", "lind-paper=10.1",
-                  "skillen-film=17.1", "lind-film=20"]
+                  "skillen-warm=15.2", "lind-warm=10.9", "skillen-film=17.1", "lind-film=20"]
 
 
 def t_sim_of(specs, method: str, dp: float) -> float:
     """T_sim of a case from --t-sim entries: T, METHOD=T or METHOD@DP_MM=T, the most specific wins;
-    a start check's METHOD (``skillen-paper``, ``skillen-film``) falls back to its method's entries."""
+    a start check's METHOD (``skillen-paper``, ``-warm``, ``-film``) falls back to its method's entries."""
     best, rank = 12.5, -1
     names = [method] + ([method.split("-")[0]] if "-" in method else [])
     for s in specs:
@@ -105,7 +106,7 @@ def t_sim_of(specs, method: str, dp: float) -> float:
 
 def start_checks(cfg: dict) -> list[tuple[float, float, str, str]]:
     """(dp, ch, method, start) of the campaign's start checks (study.flows.conveyor.start_checks),
-    the start ``paper`` or ``film``."""
+    the start ``paper``, ``warm`` or ``film``."""
     from study.flows.conveyor import CHECK_STARTS, cases
     return [(c.dp, c.ch, c.shifting, c.tag.split("-")[0]) for c in cases(cfg) if c.tag in CHECK_STARTS]
 

@@ -249,15 +249,18 @@ def test_the_start_check_sets_both_starts_side_by_side_and_says_whether_they_agr
     assert start_check_section(start_check_campaign(0.0).isel(case=[0])) == ""
 
 
-def test_a_film_start_check_is_paired_and_named_by_its_start():
-    """A campaign that starts as the paper does is checked from the moving film: the check
-    pairs with its grid run by its own tag, and the report says which start it ran from."""
+@pytest.mark.parametrize("tag, words", [
+    ("film-start", "(from the film start: the steady lubrication front moving with the film's velocity profile"),
+    ("warm-start", "(from a warm start: the final state of the run at the next coarser dp)")])
+def test_a_check_from_another_start_is_paired_and_named_by_its_start(tag, words):
+    """A campaign that starts as the paper does is checked from a warm start or the moving film:
+    the check pairs with its grid run by its own tag, and the report says which start it ran from."""
     from study import startcheck
     from study.report import start_check_section
-    tab = startcheck.table(start_check_campaign(0.001, "film-start"))
-    assert list(tab["check"].values) == ["dp1mm_ch1.8_skillen_film-start"]
-    assert list(tab["start"].values) == ["film-start"] and bool(tab["agree"].all())
-    text = html.unescape(start_check_section(start_check_campaign(0.001, "film-start")))
-    assert "(from the film start: the steady lubrication front moving with the film's velocity profile" in text
+    tab = startcheck.table(start_check_campaign(0.001, tag))
+    assert list(tab["check"].values) == [f"dp1mm_ch1.8_skillen_{tag}"]
+    assert list(tab["start"].values) == [tag] and bool(tab["agree"].all())
+    text = html.unescape(start_check_section(start_check_campaign(0.001, tag)))
+    assert words in text
     assert "the paper's start: a block" not in text
     assert startcheck.table(start_check_campaign(0.001, "other-start")).sizes["check"] == 0

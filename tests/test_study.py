@@ -94,10 +94,18 @@ def test_configs_validate_and_expand():
     paper = campaign_config.validate(load("paper.yaml"))
     cs = cfgmod.configured_cases(paper)
     assert len(cs) == 18 and len(cfgmod.cases(paper)) == 20
-    # paper.yaml starts as the paper does: its checks start from the moving film
-    assert [c.id for c in cfgmod.cases(paper)[18:]] == ["dp0.25mm_ch1.8_skillen_film-start",
-                                                        "dp0.25mm_ch1.8_lind_film-start"]
-    assert all(c.overrides == startcheck.FILM_START for c in cfgmod.cases(paper)[18:])
+    # paper.yaml starts as the paper does: its checks start warm from the runs at dp = 0.5 mm
+    checks = cfgmod.cases(paper)[18:]
+    assert [c.id for c in checks] == ["dp0.25mm_ch1.8_skillen_warm-start", "dp0.25mm_ch1.8_lind_warm-start"]
+    for c in checks:
+        d = cfgmod.case_dict(paper, c)
+        assert d["start"] == "warm" and d["warm_from"].endswith(f"dp0.5mm_ch1.8_{c.shifting}/run.nc")
+        assert cfgmod.warm_source(paper, c).id == f"dp0.5mm_ch1.8_{c.shifting}"
+    # accuracy.yaml has one dp, nothing coarser to start warm from: its checks start from the moving film
+    accuracy = campaign_config.validate(load("accuracy.yaml"))
+    checks = [c for c in cfgmod.cases(accuracy) if c.tag]
+    assert [c.id for c in checks] == ["dp1mm_ch1.8_skillen_film-start", "dp1mm_ch1.8_lind_film-start"]
+    assert all(c.overrides == startcheck.FILM_START for c in checks)
     assert {c.dp for c in cs} == {0.001, 0.0005, 0.00025}
     assert {c.ch for c in cs} == {1.0, 1.3, 1.5, 1.8, 2.2}
     assert {c.ch for c in cs if c.shifting == "lind"} == {1.8}

@@ -108,8 +108,9 @@ def start_check_section(ds: xr.Dataset) -> str:
                    "<th>check's start (&plusmn; 2 se)</th><th>difference (&plusmn; 2 se)</th>"
                    f"<th>within 2 se</th></tr>{cells}</table>")
     return ("<p>At the finest dp, each shifting method ran once more from another start: the paper's (a "
-            "block at rest at the normal depth, the belt ramped up from rest), or the moving film where the "
-            "campaign's run starts as the paper does. Each se holds the metric's wander from one "
+            "block at rest at the normal depth, the belt ramped up from rest), or, where the campaign's run "
+            "starts as the paper does, a warm start from the next coarser dp (the moving film without one). "
+            "Each se holds the metric's wander from one "
             "window to the next (its autocorrelation over the seconds before the window, calibrated on runs "
             "carried on for 110 s: docs/metrics.md). Where the two runs agree within 2 se, the answer does not "
             "depend on the start. Where they differ by more, the difference is real: the start changes the "

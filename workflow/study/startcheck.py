@@ -1,8 +1,9 @@
 """The start check: at the finest dp, each shifting method's run from the campaign's start beside
 the same case run from another start: the paper's (a block at rest, the belt ramped up from rest),
-or, where the campaign's run starts that way already, the moving film (the steady lubrication
-front with the film's velocity profile, the belt at full speed from t = 0). Pure functions over
-the campaign dataset (study.campaign.build)."""
+or, where the campaign's run starts that way already, the final state of the next coarser run
+(a warm start), or the moving film (the steady lubrication front with the film's velocity
+profile, the belt at full speed from t = 0) where there is no coarser run. Pure functions over the
+campaign dataset (study.campaign.build)."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,21 +11,26 @@ import xarray as xr
 
 from solver.schemes import FILM_START, PAPER_START
 
-# a start check's tag (the end of its case id) -> the case keys of its start, and the start in words
-CHECK_STARTS = {"paper-start": PAPER_START, "film-start": FILM_START}
+# a start check's tag (the end of its case id) -> the case keys of its start (a warm start's
+# source is set where the case file is written), and the start in words
+CHECK_STARTS = {"paper-start": PAPER_START, "warm-start": {}, "film-start": FILM_START}
+WARM_CHECK = "warm-start"
 CHECK_START_WORDS = {
     "paper-start": "the paper's start: a block at rest at the normal depth, the belt ramped up from rest",
+    "warm-start": "a warm start: the final state of the run at the next coarser dp",
     "film-start": ("the film start: the steady lubrication front moving with the film's velocity profile, "
                    "the belt at full speed from t = 0"),
 }
 Z = 2.0  # two runs agree on a metric where |difference| <= Z se of the difference
 
 
-def check_tag(start: str, start_velocity: str) -> str:
-    """The tag of the check for a run that starts this way: the paper's start, or the film's
-    where the run starts as the paper does."""
-    own = {"start": start, "start_velocity": start_velocity}
-    return "film-start" if own == PAPER_START else "paper-start"
+def check_tag(start: str, start_velocity: str, coarser: bool) -> str:
+    """The tag of the check for a run that starts this way: the paper's start; where the run
+    starts as the paper does, a warm start from the next coarser run (``coarser``: there is one)
+    or else the moving film."""
+    if {"start": start, "start_velocity": start_velocity} != PAPER_START:
+        return "paper-start"
+    return WARM_CHECK if coarser else "film-start"
 
 
 def metric_names(ds: xr.Dataset) -> list[str]:

@@ -11,7 +11,7 @@ import xarray as xr
 
 from .. import layout
 from ..grid import Case, expand, matches, physical_axes, set_key
-from ..startcheck import CHECK_STARTS, check_tag
+from ..startcheck import CHECK_STARTS, WARM_CHECK, check_tag
 from ..schema import ConfigError, checked
 from .base import Flow
 
@@ -90,7 +90,8 @@ def configured_cases(cfg: dict) -> list[Case]:
 def start_checks(cfg: dict, found: list[Case]) -> list[Case]:
     """With ``start_check``: at the finest grid dp, for each shifting method, the grid case at the
     Ch nearest grid.paper_ch run once more from another start (``startcheck.check_tag``: the
-    paper's, or the moving film's where that case starts as the paper does), tagged with it."""
+    paper's; where that case starts as the paper does, a warm start from the next coarser grid
+    run (``coarser_case``) or, with none, the moving film), tagged with it."""
     grid = [c for c in found if c.on_grid and c.realisation == 0 and c.axes == base_axes(cfg)]
     if not cfg.get("start_check", True) or not grid:
         return []
@@ -105,7 +106,7 @@ def start_checks(cfg: dict, found: list[Case]) -> list[Case]:
             own = case_from_dict(case_dict(cfg, c))
         except SceneError:  # validate() reports it, naming the case
             continue
-        tag = check_tag(own.start, own.start_velocity)
+        tag = check_tag(own.start, own.start_velocity, coarser_case(cfg, c) is not None)
         checks.append(Case(c.dp, c.ch, sh, tag, dict(CHECK_STARTS[tag]), axes=c.axes))
     taken = {c.id for c in found}
     return [c for c in checks if c.id not in taken]
@@ -128,11 +129,16 @@ def _merge(base: dict, changes: dict) -> dict:
 
 
 def warm_source(cfg: dict, case: Case) -> Case | None:
-    """With ``warm_start``: the grid case at the next coarser dp with the same Ch and shifting,
-    whose final state starts this one: its same realisation, or its realisation 0 where that
-    grid point ran fewer; None for the coarsest and extra cases."""
-    if not cfg.get("warm_start") or not case.on_grid:
-        return None
+    """The run whose final state starts this one: with ``warm_start``, for a grid case, and for a
+    warm-start check (``startcheck.WARM_CHECK``) always, ``coarser_case``; else None."""
+    if case.tag == WARM_CHECK or (cfg.get("warm_start") and case.on_grid):
+        return coarser_case(cfg, case)
+    return None
+
+
+def coarser_case(cfg: dict, case: Case) -> Case | None:
+    """The grid case at the next coarser dp with the same Ch, shifting and physical axes: its same
+    realisation, or its realisation 0 where that grid point ran fewer; None for the coarsest."""
     coarser = [c for c in configured_cases(cfg) if c.on_grid and c.ch == case.ch and c.shifting == case.shifting
                and c.axes == case.axes and c.dp > case.dp]
     if not coarser:
