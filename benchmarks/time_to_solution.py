@@ -12,7 +12,7 @@ lies within that spread of the case's is "equal" to it.
 With --campaign FILE it times whole campaigns instead: ``snakemake --cores --threads --configfile
 FILE --config name=timing_STEM_VARIANT KEY=VALUE ...`` for each variant (its KEY=VALUE campaign
 keys, ``case`` the file as given), one after the other, each under its own name
-(results/timing_STEM_VARIANT/, replaced by each timing; with --reuse a variant whose folder
+(results/ and reports/timing_STEM_VARIANT/, replaced by each timing; with --reuse a variant whose folder
 holds a reduced campaign is read, not run again, and its wall time is not known). It prints
 each campaign's wall time, the span and the summed wall of its runs, how many are steady, how
 many start checks agree on every metric, and each run's averaging window, end and wall; the
@@ -64,8 +64,9 @@ def campaigns(a, variants: dict) -> int:
         folder = common.ROOT / "results" / label
         wall = "-"
         if not (a.reuse and (folder / "campaign.nc").exists()):
-            if folder.exists():
-                shutil.rmtree(folder)
+            for old in (folder, common.ROOT / "reports" / label):  # with its report left, nothing would rerun
+                if old.exists():
+                    shutil.rmtree(old)
             cmd = [sys.executable, "-m", "snakemake", "--cores", str(a.threads), "--configfile", str(a.campaign),
                    "--config", f"name={label}", *sets]
             start = time.perf_counter()
