@@ -70,6 +70,16 @@ def test_a_chain_of_warm_starts_is_scheduled_by_its_whole_length():
     assert max(cold, key=cold.get).startswith("dp1mm") and cold["dp2.25mm_ch1.8_skillen"] < 0.1
 
 
+@pytest.mark.parametrize("tag", ["paper-start", "warm-start", "film-start"])
+def test_an_extra_case_may_not_take_a_start_checks_tag(tag):
+    c = load("config.yaml")
+    c["extra_cases"] = [{"dp": 0.003, "ch": 1.8, "shifting": "lind", "tag": tag}]
+    with pytest.raises(schema.ConfigError, match=f"extra_cases: tag '{tag}' is the start checks'"):
+        campaign_config.validate(c)
+    c["extra_cases"][0]["tag"] = "mine"
+    assert any(k.id == "dp3mm_ch1.8_lind_mine" for k in cfgmod.cases(campaign_config.validate(c)))
+
+
 def test_lind_below_ch_1_1_is_refused_before_any_job_with_the_reason():
     c = load("config.yaml")
     c["grid"] = {"dp": [0.003], "ch": [1.0, 1.8], "shifting": ["lind"]}

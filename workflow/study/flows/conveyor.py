@@ -54,6 +54,10 @@ def base_axes(cfg: dict) -> tuple:
 def validate(config: dict) -> dict:
     """The schema (with its defaults), then every case as the solver reads it."""
     cfg = checked(config, SCHEMA, _message)
+    for extra in cfg.get("extra_cases") or []:
+        if extra.get("tag") in CHECK_STARTS:
+            raise ConfigError(f"config key extra_cases: tag {extra['tag']!r} is the start checks' "
+                              f"({', '.join(CHECK_STARTS)}); give the case another tag")
     for key, _ in physical_axes(cfg["grid"]):
         if key.split(".")[1] in GRID_KEYS:
             raise ConfigError(f"config key grid.{key}: {key.split('.')[1]} is set by the grid itself "
