@@ -55,7 +55,7 @@ SLOT_GROUPS = (
     ("packing", ("GCX", "GCZ", "DIVR", "WNX", "WNZ", "DIVDR")),
     # consistent laminar term: sum_b V_b gradW_ab, div r with m/rho, the normaliser N
     ("laminar_correction", ("VGX", "VGZ", "VDIVR", "NORM")),
-    ("velocity_gradient", ("DUX", "DUZ", "DWX", "DWZ")),  # sum_b V_b (u_b - u_a) gradW_ab
+    ("velocity_gradient", ("DUX", "DUZ", "DWX", "DWZ")),  # sum_b V_b (u_b - u_a) gradW_ab (rheology)
     ("stress_transpose", ("TX", "TZ")),  # div of nu (grad u)^T, sum_b V_b (S_b - S_a) . gradW_ab
     ("strain_correction", ("LAPG", "SUPP")),  # Laplacian of the last strain rate, the support
     ("volume", ("VOLC",)),  # the volume relaxation's concentration sum_b V_b W_ab
@@ -80,7 +80,7 @@ class PairOptions(NamedTuple):
         """Which slot groups of SLOT_GROUPS this variant sums."""
         return {"always": True, "packing": self.packing >= 1,
                 "laminar_correction": self.laminar_correction,
-                "velocity_gradient": self.laminar_correction or self.rheology >= 1,
+                "velocity_gradient": self.rheology >= 1,
                 "stress_transpose": self.stress and self.rheology >= 1,
                 "strain_correction": self.rheology == 2, "volume": self.packing == 2,
                 "implicit": self.implicit_walls > 0.0}
@@ -164,7 +164,11 @@ class PairFields(NamedTuple):
     gamma: np.ndarray  # each particle's last strain rate (read with strain_correction only)
     cell: np.ndarray  # lattice cell dx dz of each particle (read with shifting only)
     irho: np.ndarray  # 1 / rho of each particle (``pressure_and_inverse_density``)
-    vscale: np.ndarray  # each particle's laminar-term factor (read with viscous_scale only)
+    vscale: np.ndarray  # each particle's laminar-term factor (read with laminar_correction only)
+    # each particle's c = 2 nu G / N of the last evaluation, its laminar term's first-order error
+    # c . grad u (``viscous_scale_factors``; read with laminar_correction only)
+    vcx: np.ndarray
+    vcz: np.ndarray
     # the last transpose stress S_ij = nu d_i u_j (read with the stress form only)
     sxx: np.ndarray
     sxz: np.ndarray
@@ -304,14 +308,16 @@ def make_pair_loop(options: PairOptions):
     diffusion: D_a with the paper's rho^H_ab (1) or the Tait column's (2), fluid pairs only.
     packing: gradC, div r and the wall normals into GCX..WNZ, the last shift's div(dr) into
     DIVDR; at 2 also the concentration sum_b V_b W_ab (every pair with a fluid particle) into VOLC,
-    for ``packing.relax_density``. laminar_correction: the sums of ``correct_viscous_term`` and the
-    normaliser N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)) into NORM, and each pair's laminar term
-    times the mean of its two particles' factors ``f.vscale`` (a fluid-wall pair's by the fluid
-    particle's). rheology: each pair's viscosity from the particles' nu_p (``pair_viscosity``) and
-    the velocity gradient into DUX..DWZ (``rheology``); with stress also the divergence of the
-    last transpose stress S = nu (grad u)^T (``f.sxx`` .. ``f.szz``), sum_b V_b (S_b - S_a) . gradW_ab
-    over fluid pairs, into TX, TZ (``add_stress_transpose``);
-    at 2 also the Laplacian
+    for ``packing.relax_density``. laminar_correction: G = sum_b V_b gradW_ab into VGX, VGZ, div r
+    with m/rho volumes into VDIVR and the normaliser N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2))
+    into NORM (``viscous_scale_factors`` makes them the next evaluation's factors); each pair's
+    laminar term times the mean of its two particles' factors ``f.vscale`` (a fluid-wall pair's by
+    the fluid particle's), and each particle's first-order error c . grad u, c = ``f.vcx``,
+    ``f.vcz``, subtracted in the same sums. rheology: each pair's viscosity from the particles'
+    nu_p (``pair_viscosity``) and the velocity gradient into DUX..DWZ (``rheology``); with stress
+    also the divergence of the last transpose stress S = nu (grad u)^T (``f.sxx`` .. ``f.szz``),
+    sum_b V_b (S_b - S_a) . gradW_ab over fluid pairs, into TX, TZ (``add_stress_transpose``); at 2
+    also the Laplacian
     2 sum_b V_b (g_a - g_b) F r^2 / (r^2 + eta^2) of the last strain rate g = ``f.gamma`` into LAPG
     and the support sum_b V_b (-F r^2) / 2 into SUPP, over fluid pairs. artificial: Monaghan's
     artificial viscosity (all pairs, walls included, as DualSPHysics). implicit_walls > 0: the
@@ -321,7 +327,7 @@ def make_pair_loop(options: PairOptions):
     diffusion, packing, rheology = o.diffusion, o.packing, o.rheology
     laminar_correction, artificial, implicit_walls = o.laminar_correction, o.artificial, o.implicit_walls
     implicit = implicit_walls > 0.0
-    velocity_gradient = laminar_correction or rheology >= 1
+    velocity_gradient = rheology >= 1
     stress = o.stress and rheology >= 1
     sl = slot_layout(o)
     NQ = sl.nq
@@ -386,6 +392,8 @@ def make_pair_loop(options: PairOptions):
                 cell_a = f.cell[a]
                 s = ZERO
                 sca = f.vscale[a] if laminar_correction else 1.0
+                cxa = f.vcx[a] if laminar_correction else 0.0
+                cza = f.vcz[a] if laminar_correction else 0.0
                 sxa = sza = 0.0
                 if packing:
                     sxa, sza = f.sdx[a], f.sdz[a]
@@ -448,8 +456,16 @@ def make_pair_loop(options: PairOptions):
                         pt += artificial_factor(k.av, vdotr, inv_rsum, inv_r2e, F)
                     fx = -pt * dx + vt * du
                     fz = -pt * dz + vt * dw
-                    s = add_pair(s, at, b, AX, mb * fx, -(ma * fx))
-                    s = add_pair(s, at, b, AZ, mb * fz, -(ma * fz))
+                    if laminar_correction:
+                        # -c . grad u, grad u_a = sum_b V_b (u_b - u_a) gradW_ab: a's share
+                        # V_b (c_a . gradW_ab) u_ab, b's V_a (c_b . gradW_ab) u_ab
+                        ga = Vb * F * (cxa * dx + cza * dz)
+                        gb = Va * F * (f.vcx[b] * dx + f.vcz[b] * dz)
+                        s = add_pair(s, at, b, AX, mb * fx + ga * du, gb * du - ma * fx)
+                        s = add_pair(s, at, b, AZ, mb * fz + ga * dw, gb * dw - ma * fz)
+                    else:
+                        s = add_pair(s, at, b, AX, mb * fx, -(ma * fx))
+                        s = add_pair(s, at, b, AZ, mb * fz, -(ma * fz))
                     if implicit:  # k_ab = -vt
                         if ka + kb == 0:
                             if npl < cap:
@@ -624,27 +640,6 @@ VISCOUS_CORRECTION_MIN_DIVR = 1.9  # div r (m/rho volumes) of a particle with (n
 
 
 @nb.njit(parallel=True, cache=True)
-def correct_viscous_term(out, kind, nu, n, scale, sl):
-    """Remove the first-order error of the laminar term where the kernel support is full.
-
-    By Taylor expansion the term sum_b 2 nu V_b F_ab u_ab approximates
-    nu (M : grad grad u + 2 G . grad u), G = sum_b V_b gradW_ab, M = -sum_b V_b F r_ab r_ab:
-    on a disordered arrangement G is not zero, and in a film its product with the large shear
-    makes the term too weak. For fluid particles with div r >= 1.9 (away from the free
-    surface, where G measures the missing neighbours rather than disorder) subtract
-    2 nu G . grad u times the particle's laminar factor ``scale[i]`` (as the pair loop scaled
-    the term itself), grad u = sum_b V_b (u_b - u_a) gradW_ab; ``sl``: the loop's ``Slots``.
-    Applied after the reduction: the force limit dt1 of the step uses max |a| before it."""
-    for i in nb.prange(n):
-        if kind[i] != 0 or out[sl.VDIVR, i] < VISCOUS_CORRECTION_MIN_DIVR:
-            continue
-        gx, gz = out[sl.VGX, i], out[sl.VGZ, i]
-        c = 2.0 * nu * scale[i]
-        out[AX, i] -= c * (gx * out[sl.DUX, i] + gz * out[sl.DUZ, i])
-        out[AZ, i] -= c * (gx * out[sl.DWX, i] + gz * out[sl.DWZ, i])
-
-
-@nb.njit(parallel=True, cache=True)
 def add_stress_transpose(out, kind, rho, rho0, n, sl):
     """The stress form's second half (``numerics.viscous_form: stress``): with a variable
     viscosity, div(2 mu D) = div(mu grad u) + div(mu (grad u)^T). The pair loop's laminar term
@@ -688,19 +683,31 @@ def store_stress_transpose(out, kind, nu_p, n, sl, sxx, sxz, szx, szz):
 
 
 @nb.njit(parallel=True, cache=True)
-def viscous_scale_factors(out, kind, n, sl, scale):
-    """The laminar term's normalisation for the next evaluation: scale = 1 / N for fluid
-    particles with div r >= 1.9 (m/rho volumes), 1 elsewhere, N = out[sl.NORM].
+def viscous_scale_factors(out, kind, n, sl, nu, scale, cx, cz):
+    """The consistent laminar term's factors for the next evaluation, from this one's sums: for
+    fluid particles with div r >= 1.9 (m/rho volumes) scale = 1 / N and c = 2 nu G / N,
+    elsewhere scale = 1 and c = 0 (N = out[sl.NORM], G = out[sl.VGX], out[sl.VGZ]).
 
-    By Taylor expansion the corrected term is nu sum_b V_b (-F) r^2 / (r^2 + eta^2)
-    (r_ab . grad grad u . r_ab): for the isotropic u = |r|^2 / 4 (laplacian 1) it gives nu N,
-    N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)), which a continuous kernel without eta makes 1.
-    On a square lattice at Ch 1.8, N = 0.982 (0.995 from div r / 2, the rest from eta), and so
-    is the film's response nu u''. Dividing by N removes the isotropic part of that error. Near
-    the free surface (div r < 1.9) the support is cut and the term is left as it is."""
+    By Taylor expansion the laminar term sum_b 2 nu V_b F_ab u_ab approximates
+    nu (M : grad grad u + 2 G . grad u), G = sum_b V_b gradW_ab, M = -sum_b V_b F r_ab r_ab.
+    On a disordered arrangement G is not zero, and in a film its product with the large shear
+    makes the term too weak: the pair loop subtracts c . grad u. For the isotropic
+    u = |r|^2 / 4 (laplacian 1) the term gives nu N, N = sum_b V_b (-F) r^4 / (2 (r^2 + eta^2)),
+    which a continuous kernel without eta makes 1; on a square lattice at Ch 1.8, N = 0.982
+    (0.995 from div r / 2, the rest from eta), and so is the film's response nu u''. Dividing by
+    N removes the isotropic part of that error. Near the free surface (div r < 1.9) G measures
+    the missing neighbours rather than disorder and the support is cut: the term is left as it
+    is. G and N move with the particles' arrangement, a fraction of dp over many steps, so one
+    evaluation's lag leaves them the same to within that motion."""
     for i in nb.prange(n):
-        ok = kind[i] == 0 and out[sl.VDIVR, i] >= VISCOUS_CORRECTION_MIN_DIVR
-        scale[i] = 1.0 / out[sl.NORM, i] if ok else 1.0
+        if kind[i] == 0 and out[sl.VDIVR, i] >= VISCOUS_CORRECTION_MIN_DIVR:
+            s = 1.0 / out[sl.NORM, i]
+            scale[i] = s
+            cx[i] = 2.0 * nu * s * out[sl.VGX, i]
+            cz[i] = 2.0 * nu * s * out[sl.VGZ, i]
+        else:
+            scale[i] = 1.0
+            cx[i] = cz[i] = 0.0
 
 
 @nb.njit(inline="always", cache=True)

@@ -179,7 +179,7 @@ class Numerics:
     # rho^H_ab of the diffusion: spec (the paper's form) or column (the Tait column at rest)
     density_diffusion_reference: str = "spec"
     # the consistent laminar term: its first-order error 2 nu G . grad u removed and the term
-    # divided by its lattice normaliser N where the support is full (forces.correct_viscous_term)
+    # divided by its lattice normaliser N where the support is full (forces.viscous_scale_factors)
     viscous_correction: bool = False
     # beta: interior density relaxes towards the particles' packing at a rate beta c0 / h
     # (solver/packing.py); null: off

@@ -16,6 +16,7 @@ _SORTED = ("x", "z", "u", "w", "rho", "mass", "drho_prev", "kind", "wall", "gx",
 _SHIFTING = ("cell_volume", "wnx", "wnz")  # read by the shifting sums alone
 _SHIFT = ("shift_dx", "shift_dz")  # the last shift, pending its density correction
 _IMPLICIT = ("implicit_cx", "implicit_cz")  # the last implicit correction, CG's next start
+_VISCOUS = ("viscous_scale", "viscous_cx", "viscous_cz")  # the consistent laminar term's factors
 
 
 def default_domain(scene: Scene) -> tuple[float, float, float, float]:
@@ -75,8 +76,11 @@ class Simulation:
         self.shift_method = num.shifting.method
         shifting_on = self.shift_method != "none"
         self.viscous_correction = bool(num.viscous_correction)
-        # each particle's laminar factor, from the last evaluation (viscous_correction)
+        # each particle's laminar factor and first-order correction c, from the last evaluation
+        # (viscous_correction; ``forces.viscous_scale_factors``)
         self.viscous_scale = np.ones(self.n if self.viscous_correction else 1)
+        self.viscous_cx = np.zeros(self.n if self.viscous_correction else 1)
+        self.viscous_cz = np.zeros(self.n if self.viscous_correction else 1)
         self.variable_viscosity = not s.fluid.newtonian
         self.strain_correction = self.variable_viscosity and bool(s.fluid.strain_rate_correction)
         # the last strain rate (strain_rate_correction; a placeholder otherwise)
@@ -107,7 +111,7 @@ class Simulation:
                               + (("nu_p",) if self.variable_viscosity else ())
                               + (("gamma_p",) if self.strain_correction else ())
                               + (_STRESS if self.stress_form else ())
-                              + (("viscous_scale",) if self.viscous_correction else ())
+                              + (_VISCOUS if self.viscous_correction else ())
                               + (_IMPLICIT if self.implicit and not self.substeps else ()))
         self.solver_iterations = 0  # CG iterations of the implicit viscous solves, summed
         self.rkc_stages = 0  # stages of the sub-stepped viscous updates, summed
@@ -206,6 +210,7 @@ class Simulation:
         fields = forces.PairFields(self.x, self.z, self.u, self.w, self.rho, self.p, self.mass, self.kind,
                                    self.wnx, self.wnz, self.shift_dx, self.shift_dz, self.nu_p,
                                    self.gamma_p, self.cell_volume, self.irho, self.viscous_scale,
+                                   self.viscous_cx, self.viscous_cz,
                                    self.sxx, self.sxz, self.szx, self.szz)
         self.pair_loop(fields, self.cells, self.split, self.constants, self.acc, self.vmax_t, *self.pairs)
         if self.implicit and self.pairs.count.max() > self.pairs.i.shape[1]:
@@ -216,11 +221,9 @@ class Simulation:
         self.amax = forces.reduce_accumulators(self.acc, self.kind, self.split, self.cells,
                                                s.gravity[0], s.gravity[1], self.out, self.n)
         self.vmax = float(self.vmax_t.max())
-        if self.viscous_correction:
-            forces.correct_viscous_term(self.out, self.kind, self.nu, self.n_active, self.viscous_scale,
-                                        self.slots)
-            # the factors of the next evaluation
-            forces.viscous_scale_factors(self.out, self.kind, self.n_active, self.slots, self.viscous_scale)
+        if self.viscous_correction:  # the factors of the next evaluation
+            forces.viscous_scale_factors(self.out, self.kind, self.n_active, self.slots, self.nu,
+                                         self.viscous_scale, self.viscous_cx, self.viscous_cz)
         if self.stress_form:  # the divergence of the last evaluation's transpose stress
             self.amax = max(self.amax, forces.add_stress_transpose(
                 self.out, self.kind, self.rho, self.rho0, self.n_active, self.slots))
@@ -398,8 +401,8 @@ class Simulation:
         return self.health
 
     # ---- checkpoint -------------------------------------------------------------------
-    _STATE = _SORTED + _SHIFTING + _SHIFT + _IMPLICIT + _STRESS + (
-        "nu_p", "gamma_p", "viscous_scale", "nu_max_now", "t", "steps", "info", "dt_first", "n_active", "reason")
+    _STATE = _SORTED + _SHIFTING + _SHIFT + _IMPLICIT + _STRESS + _VISCOUS + (
+        "nu_p", "gamma_p", "nu_max_now", "t", "steps", "info", "dt_first", "n_active", "reason")
 
     def state(self) -> dict:
         """Everything needed to resume exactly where this simulation stands."""

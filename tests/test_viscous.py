@@ -58,9 +58,9 @@ def quadratic_flow_response(normalised: bool, jitter: float, ch: float = 1.5) ->
     """The Couette channel at rest pressure with u = 4 U0 z (L - z) / L^2 (nu u'' = -8 nu U0 / L^2)
     on fluid particles moved by up to ``jitter`` dp: the corrected laminar term of the
     interior (2.5 h from the walls) over nu u''. Evaluated after the simulation's first
-    evaluation at the same state, whose normalisation factors 1 / N the term takes; with
-    ``normalised`` false the factors are reset to 1 before it (the corrected term before
-    its division by N)."""
+    evaluation at the same state, whose factors 1 / N and correction c = 2 nu G / N the term
+    takes; with ``normalised`` false the division by N is undone in both before it (the
+    corrected term before its division by N)."""
     sc = example_scene("couette", ch=ch, numerics={"viscous_correction": True, "density_diffusion": None})
     p = build_particles(sc)
     fl = p.kind == 0
@@ -72,7 +72,9 @@ def quadratic_flow_response(normalised: bool, jitter: float, ch: float = 1.5) ->
     p.rho[:] = sc.fluid.density
     sim = Simulation(sc, p)
     sim.derivatives()
-    if not normalised:
+    if not normalised:  # undo the division by N of the term and of its correction c = 2 nu G / N
+        sim.viscous_cx /= sim.viscous_scale
+        sim.viscous_cz /= sim.viscous_scale
         sim.viscous_scale[:] = 1.0
     d = sim.derivatives()
     s = sim.snapshot()
