@@ -697,8 +697,9 @@ def viscous_scale_factors(out, kind, n, sl, nu, scale, cx, cz):
     (0.995 from div r / 2, the rest from eta), and so is the film's response nu u''. Dividing by
     N removes the isotropic part of that error. Near the free surface (div r < 1.9) G measures
     the missing neighbours rather than disorder and the support is cut: the term is left as it
-    is. G and N move with the particles' arrangement, a fraction of dp over many steps, so one
-    evaluation's lag leaves them the same to within that motion."""
+    is. The pair loop applies these one evaluation later; G, a sum that nearly cancels, also
+    moves with each step's density corrections, so that the lagged c is not the current one
+    (docs/numerics.md, departure 3)."""
     for i in nb.prange(n):
         if kind[i] == 0 and out[sl.VDIVR, i] >= VISCOUS_CORRECTION_MIN_DIVR:
             s = 1.0 / out[sl.NORM, i]
