@@ -161,8 +161,10 @@ class Simulation:
         self.surface_nx = np.zeros(self.n if tangential else 1)  # lind's surface normals
         self.surface_nz = np.zeros(self.n if tangential else 1)
         self.wall_s0 = shifting.wall_proximity_at_half_dp(self.h, s.dp)
-        self._buf = {np.dtype(a.dtype): np.empty(self.n, a.dtype)
-                     for a in (self.x, self.kind, self.wall, self.pid)}
+        self._buf = {}  # one spare buffer for each dtype of the sorted fields
+        for name in self.sorted_fields:
+            a = getattr(self, name)
+            self._buf.setdefault(a.dtype, np.empty(self.n, a.dtype))
         self.health = np.zeros(4)
         self.n_active = self.n
 
@@ -185,12 +187,13 @@ class Simulation:
                     f"({self.x[bad]:.4g}, {self.z[bad]:.4g})")
         cells.counting_sort(self.cell, g.ncells + 1, self.order, self.start)
         cells.sort_cells_by(self.z, self.order, self.start, g.ncells)  # the pair loop's z windows
-        for name in self.sorted_fields:
+        bufs, order = self._buf, self.order
+        for name in self.sorted_fields:  # each through its dtype's spare buffer, which it then becomes
             arr = getattr(self, name)
-            buf = self._buf.setdefault(np.dtype(arr.dtype), np.empty(self.n, arr.dtype))
-            cells.gather(arr, self.order, buf)
+            buf = bufs[arr.dtype]
+            cells.gather(arr, order, buf)
             setattr(self, name, buf)
-            self._buf[np.dtype(arr.dtype)] = arr
+            bufs[arr.dtype] = arr
         self.n_active = int(self.start[g.ncells])
         self.drho_prev[self.n_active:] = 0.0
         cells.column_split(self.cells, self.nthreads, self.split)
