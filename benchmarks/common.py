@@ -254,26 +254,41 @@ def reference(run):
 
 
 def metrics(run, ref=None) -> dict:
-    """zeta_f, zeta_f_se, zeta_h, zeta_fs and zeta_u at each station (``zeta_u_0.76``...) of
-    a front run (study.metrics.case_metrics; NaN for a diverged run)."""
+    """zeta_f, zeta_h, zeta_fs and zeta_u at each station (``zeta_u_0.76``...) of a front run,
+    each with its standard error (``zeta_h_se``...; study.metrics.case_metrics; NaN for a
+    diverged run)."""
     from study.metrics import case_metrics
     m = case_metrics(run, reference(run) if ref is None else ref, X_STAR_RANGE)
-    out = {k: float(m[k]) for k in ("zeta_f", "zeta_f_se", "zeta_h", "zeta_fs")}
-    for s, v in zip(m["station"].values, m["zeta_u"].values):
-        out[f"zeta_u_{s:g}"] = float(v)
+    out = {k: float(m[k]) for k in ("zeta_f", "zeta_f_se", "zeta_h", "zeta_h_se", "zeta_fs", "zeta_fs_se")}
+    for s, v, e in zip(m["station"].values, m["zeta_u"].values, m["zeta_u_se"].values):
+        out[f"zeta_u_{s:g}"], out[f"zeta_u_{s:g}_se"] = float(v), float(e)
     return out
+
+
+def largest_shift(new: dict, old: dict) -> tuple[float, str]:
+    """(largest |new - old| / sqrt(se_new^2 + se_old^2) over the metrics, its metric) of two
+    ``metrics`` dicts: a shift above 2 is a change beyond 2 se; NaN where no metric has both se."""
+    shifts = {k: abs(new[k] - old[k]) / math.hypot(new[f"{k}_se"], old[f"{k}_se"])
+              for k in new if k.startswith("zeta_") and f"{k}_se" in new and f"{k}_se" in old}
+    shifts = {k: v for k, v in shifts.items() if math.isfinite(v)}
+    if not shifts:
+        return math.nan, ""
+    k = max(shifts, key=shifts.get)
+    return shifts[k], k
 
 
 def describe(path: Path) -> dict:
     """A front run's metrics, status, steady time, simulated time, steps, particles, wall time
-    of its time stepping and particle-steps/s."""
+    of its time stepping, particle-steps/s and largest max |rho/rho0 - 1| over the run."""
     import xarray as xr
     with xr.open_dataset(path) as ds:
         run = ds.load()
     a = run.attrs
     n = int(a["n_fluid"]) + int(a["n_boundary"])
     wall = float(a["wall_time_s"])
+    dev = float(run["max_density_deviation"].max()) if "max_density_deviation" in run else math.nan
     return {**metrics(run), "status": a["status"], "steady_at": float(a["steady_state_time_s"]),
+            "density_deviation": dev,
             "simulated": float(a["simulated_time_s"]), "steps": int(a["steps"]), "particles": n,
             "wall": wall, "rate": n * int(a["steps"]) / wall if wall > 0 else math.nan}
 

@@ -7,7 +7,10 @@ threads. A variant is a name and its overrides (``--variant NAME KEY=VALUE ...``
 ``case`` is the case as given. --spread also runs the case on 1 thread: the two thread counts
 sum the pair contributions in another order, so round-off starts two runs of the same physics
 apart, and a metric that moves less than between them is noise. A variant whose every metric
-lies within that spread of the case's is "equal" to it.
+lies within that spread of the case's is "equal" to it. "largest shift / se" is each variant's
+largest |metric - case's| / sqrt(se^2 + se_case^2) over the metrics (benchmarks.common.largest_shift),
+with its metric: above 2, that metric moved beyond 2 se. "max |rho/rho0 - 1|" is the largest over
+the run. A sound-speed sweep is ``--variant c8 coefsound=8.0 --variant c9 coefsound=9.0``.
 
 With --campaign FILE it times whole campaigns instead: ``snakemake --cores --threads --configfile
 FILE --config name=timing_STEM_VARIANT KEY=VALUE ...`` for each variant (its KEY=VALUE campaign
@@ -124,20 +127,24 @@ def main(argv=None) -> int:
                       if k.startswith("zeta_") and not k.endswith("_se")}
             results["case, 1 thread"] = one
         for v, m in results.items():
-            verdict = "-"
+            verdict, shift = "-", "-"
             if spread and v not in ("case", "case, 1 thread"):
                 equal = all(abs(m[k] - results["case"][k]) <= s for k, s in spread.items())
                 verdict = "yes" if equal else "no"
-            rows.append({"shifting": method, "variant": v, **m, "equal": verdict, "spread": spread})
+            if v != "case":
+                z, k = common.largest_shift(m, results["case"])
+                shift = f"{z:.1f} ({k})" if k else "-"
+            rows.append({"shifting": method, "variant": v, **m, "equal": verdict, "shift": shift, "spread": spread})
     (a.out / "time_to_solution.json").write_text(json.dumps(rows, indent=1))
     zetas = [k for k in rows[0] if k.startswith("zeta_") and not k.endswith("_se")]
     print(f"case: {a.case.relative_to(common.ROOT) if a.case.is_relative_to(common.ROOT) else a.case} "
           f"{' '.join(a.sets)}; {a.threads} threads")
     print(common.table(
         ["shifting", "variant", "status", "steady at [s]", "simulated [s]", "steps", "wall [s]", "M particle-steps/s",
-         *zetas, "equal to case"],
+         *zetas, "max \\|rho/rho0 - 1\\| %", "largest shift / se", "equal to case"],
         [[r["shifting"], r["variant"], r["status"], f"{r['steady_at']:.2f}", f"{r['simulated']:.2f}", r["steps"],
-          f"{r['wall']:.1f}", f"{r['rate'] / 1e6:.2f}", *(f"{r[k]:.4f}" for k in zetas), r["equal"]] for r in rows]))
+          f"{r['wall']:.1f}", f"{r['rate'] / 1e6:.2f}", *(f"{r[k]:.4f}" for k in zetas),
+          f"{100 * r['density_deviation']:.2f}", r["shift"], r["equal"]] for r in rows]))
     for r in rows:
         if r["spread"] and r["variant"] == "case":
             print(f"\nrun-to-run spread ({r['shifting']}, 1 against {a.threads} threads): "
