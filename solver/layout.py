@@ -56,21 +56,14 @@ def lattice(rect, dp: float) -> tuple[np.ndarray, np.ndarray, float, float]:
 
 def profile_lattice(profile, dp: float) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Lattice points of a profile region: columns filling [x0, x1] (``stretched_points``), rows
-    dz apart from base + dz/2, and the spacings (dx, dz), dz the row spacing
-    (``FluidProfile.row_spacing``). A column holds round((top - base) / dz) rows (fill
-    ``nearest``), or (fill ``area``) n_k = round(S_k) - round(S_(k-1)) rows, S_k the sum of
-    (top - base) / dz over the columns up to k: the fill's area stays within half a cell of
-    sum_k dx (top_k - base), which per-column rounding misses by up to half a row a column where
-    the depth is nearly uniform."""
+    dz apart from base + dz/2 while below the surface (round((top - base) / dz) rows per column),
+    and the spacings (dx, dz), dz the row spacing (``FluidProfile.row_spacing``)."""
     dz = profile.row_spacing(dp)
     xs, dx = stretched_points(*profile.x, dp)
-    depth = np.maximum(profile.top(xs) - profile.base, 0.0) / dz
-    if profile.fill == "area":
-        rows = np.diff(np.floor(np.cumsum(depth) + 0.5), prepend=0.0)
-    else:
-        rows = np.floor(depth + 0.5)
+    tops = profile.top(xs)
     X, Z = [], []
-    for x, n in zip(xs, rows.astype(np.int64)):
+    for x, top in zip(xs, tops):
+        n = int(np.floor((top - profile.base) / dz + 0.5))
         if n > 0:
             X.append(np.full(n, x))
             Z.append(profile.base + (np.arange(n) + 0.5) * dz)

@@ -29,7 +29,7 @@ _DIAG_META = {
 _SNAP_META = {
     "x": ("m", "position along x"), "z": ("m", "position along z"),
     "u": ("m s-1", "velocity along x"), "w": ("m s-1", "velocity along z"),
-    "rho": ("kg m-3", "density"), "p": ("Pa", "pressure"), "mass": ("kg m-1", "mass per unit width"),
+    "rho": ("kg m-3", "density"), "p": ("Pa", "pressure"),
     "kind": ("1", "0 fluid, 1 boundary"),
     "mu": ("Pa s", "effective viscosity (Herschel-Bulkley; max_viscosity where unyielded)"),
 }

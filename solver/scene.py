@@ -58,9 +58,6 @@ class FluidBlock(Rect):
     velocity: tuple[float, float] = (0.0, 0.0)
 
 
-PROFILE_FILLS = ("nearest", "area")
-
-
 @dataclass
 class FluidProfile:
     """Fluid between z = ``base`` and a piecewise-linear free surface through the
@@ -71,10 +68,6 @@ class FluidProfile:
     surface: list[tuple[float, float]]
     velocity: tuple[float, float] = (0.0, 0.0)
     row_depth: float | None = None  # rows dz = row_depth / round(row_depth / dp) apart; null: dp
-    # each column's rows: "nearest", its depth rounded to whole rows; "area", as many rows as keep
-    # the fill's running area within half a cell of the area under the surface (so the whole
-    # profile's area is kept, each column within one row of its depth)
-    fill: str = "nearest"
 
     def row_spacing(self, dp: float) -> float:
         """Vertical spacing of the fill: a column of depth ``row_depth`` holds a whole number
@@ -585,8 +578,6 @@ def validate(scene: Scene) -> None:
             raise SceneError(f"{key}.surface: lies entirely below {key}.base")
         if pr.row_depth is not None and not (0.5 * scene.dp <= pr.row_depth):
             raise SceneError(f"{key}.row_depth: must be at least dp / 2, or null, got {pr.row_depth}")
-        if pr.fill not in PROFILE_FILLS:
-            raise SceneError(f"{key}.fill: must be one of {', '.join(PROFILE_FILLS)}, got {pr.fill!r}")
     regions = [(f"fluid.blocks[{j}]", b) for j, b in enumerate(scene.fluid.blocks)] + [
         (f"fluid.profiles[{j}]", p.bbox) for j, p in enumerate(scene.fluid.profiles)]
     for i, w in enumerate(scene.walls):

@@ -450,7 +450,7 @@ class Simulation:
         """Particle fields in original particle order (fluid first, then walls)."""
         inv = self._inverse_order()
         p = self.pressure()
-        fields = dict(x=self.x, z=self.z, u=self.u, w=self.w, rho=self.rho, p=p, mass=self.mass, kind=self.kind)
+        fields = dict(x=self.x, z=self.z, u=self.u, w=self.w, rho=self.rho, p=p, kind=self.kind)
         if self.variable_viscosity:  # the effective viscosity: where the fluid has yielded
             fields["mu"] = self.nu_p * self.rho0
         return {k: v[inv].copy() for k, v in fields.items()}

@@ -1,13 +1,10 @@
 """Warm start of a conveyor case from the final state of a run at another resolution.
 
-The fine lattice fills the region under a free surface that holds the coarse run's fluid
-area: each coarse column (dp wide, from the upstream wall to the toe) is as high as its
-particles' area sum m / rho over dp, averaged over the columns within h of it (the total
-kept), and the fill keeps that area (fill ``area``, solver.layout.profile_lattice), so that
-both runs hold the same fluid. Densities start hydrostatic as for any profile;
-velocities are the Shepard interpolation of the coarse fluid velocities,
-u(r) = sum_j u_j W(r - r_j) / sum_j W(r - r_j) with the coarse h. The belt runs at full speed
-from t = 0.
+The fine lattice fills the region under the coarse run's free surface (the top of each
+coarse particle column plus dp/2, from the upstream wall to the toe); densities start
+hydrostatic as for any profile; velocities are the Shepard interpolation of the coarse
+fluid velocities, u(r) = sum_j u_j W(r - r_j) / sum_j W(r - r_j) with the coarse h.
+The belt runs at full speed from t = 0.
 """
 from __future__ import annotations
 
@@ -25,34 +22,21 @@ class WarmState:
     z: np.ndarray
     u: np.ndarray
     w: np.ndarray
-    volume: np.ndarray  # m / rho of each particle
     dp: float
     h: float
     toe: float
     status: str
 
-    def column_heights(self) -> tuple[np.ndarray, np.ndarray]:
-        """(x, height) of each dp-wide column from x = 0 past the toe: its particles' area over
-        dp, averaged over the round(h / dp) columns either side (mirrored at the upstream wall)
-        and scaled back to the total area."""
-        edges = np.arange(0.0, self.toe + self.dp, self.dp)
-        col = np.clip(np.digitize(self.x, edges) - 1, 0, edges.size - 2)
-        height = np.bincount(col, weights=self.volume, minlength=edges.size - 1) / self.dp
-        k = max(int(round(self.h / self.dp)), 1)
-        padded = np.concatenate([height[k:0:-1], height, np.zeros(k)])
-        smooth = np.convolve(padded, np.full(2 * k + 1, 1.0 / (2 * k + 1)), mode="valid")
-        smooth *= height.sum() / smooth.sum()
-        return 0.5 * (edges[:-1] + edges[1:]), smooth
-
-    @property
-    def area(self) -> float:
-        return float(self.volume.sum())
-
     def surface(self) -> list[list[float]]:
-        """(x, z) points of the free surface from x = 0 to the toe (``column_heights``)."""
-        xs, height = self.column_heights()
-        pts = [[0.0, float(height[0])]]
-        pts += [[float(a), float(b)] for a, b in zip(xs, height) if a < self.toe]
+        """(x, z) points of the free surface from x = 0 to the toe."""
+        edges = np.arange(0.0, self.toe + self.dp, self.dp)
+        col = np.digitize(self.x, edges) - 1
+        top = np.full(edges.size - 1, np.nan)
+        np.fmax.at(top, np.clip(col, 0, top.size - 1), self.z)
+        xs = 0.5 * (edges[:-1] + edges[1:])
+        ok = np.isfinite(top)
+        pts = [[0.0, float(top[ok][0] + 0.5 * self.dp)]]
+        pts += [[float(a), float(b + 0.5 * self.dp)] for a, b in zip(xs[ok], top[ok]) if a < self.toe]
         pts.append([float(self.toe), 0.0])
         return pts
 
@@ -78,9 +62,6 @@ def load(path) -> WarmState:
             raise ValueError(f"{path}: the run diverged ({ds.attrs.get('reason', '')}); no state to start from")
         s = ds.isel(snapshot=-1)
         f = s["kind"].values == 0
-        dp = float(ds.attrs["dp"])
-        # m / rho; a run written without masses: its lattice cells, dp^2
-        volume = s["mass"].values[f] / s["rho"].values[f] if "mass" in s else np.full(int(f.sum()), dp * dp)
         return WarmState(x=s["x"].values[f], z=s["z"].values[f], u=s["u"].values[f], w=s["w"].values[f],
-                         volume=volume, dp=dp, h=float(ds.attrs["h"]),
+                         dp=float(ds.attrs["dp"]), h=float(ds.attrs["h"]),
                          toe=float(ds["toe_position"].values[-1]), status=str(ds.attrs.get("status")))

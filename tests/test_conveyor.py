@@ -280,33 +280,6 @@ def test_warm_start_fills_the_coarse_state(tmp_path):
     np.testing.assert_allclose(w, 0.01, atol=1e-12)
 
 
-def test_warm_start_keeps_a_disordered_state_area(tmp_path):
-    """A coarse state whose particles stray from their lattice (up to 0.3 dp, the top row
-    ragged), 18.6 fine rows deep behind a nose that thins to the toe over 0.05 m: the fine
-    fill holds its area sum m / rho to 0.1 % (per-column rounding of this surface: 2 % high;
-    the topmost particle of each column plus dp / 2 as the surface: 0.26 % high)."""
-    from solver import warm
-    dp_c, dp_f, length, depth = 3.0e-3, 2.1e-3, 0.3, 0.039
-    xs, zs = np.meshgrid(np.arange(0.5, round(length / dp_c)) * dp_c, np.arange(0.5, round(depth / dp_c)) * dp_c)
-    keep = zs.ravel() < depth * np.minimum(1.0, (length - xs.ravel()) / 0.05)
-    rng = np.random.default_rng(3)
-    x = np.clip(xs.ravel()[keep] + rng.uniform(-0.3, 0.3, keep.sum()) * dp_c, 0.2 * dp_c, length - 0.2 * dp_c)
-    z = np.abs(zs.ravel()[keep] + rng.uniform(-0.3, 0.3, keep.sum()) * dp_c)
-    rho = np.full(x.size, 1000.0)
-    snap = {k: (("snapshot", "particle"), v[None]) for k, v in
-            {"x": x, "z": z, "u": np.full(x.size, -0.075), "w": np.zeros(x.size), "rho": rho,
-             "mass": rho * dp_c * dp_c, "kind": np.zeros(x.size, dtype=np.int8)}.items()}
-    xr.Dataset({**snap, "toe_position": ("time", [length])},
-               attrs={"dp": dp_c, "h": 1.5 * dp_c, "status": "completed", "reason": ""}).to_netcdf(tmp_path / "c.nc")
-    state = warm.load(tmp_path / "c.nc")
-    area = x.size * dp_c * dp_c
-    assert state.area == pytest.approx(area, rel=1e-12)
-    c = paper(start="warm", warm_from=str(tmp_path / "c.nc"), dp=dp_f, ch=1.5)
-    p = build_particles(build_scene(c, state))
-    fine = np.sum(p.mass[p.kind == 0] / p.rho[p.kind == 0])
-    assert fine == pytest.approx(area, rel=1e-3)
-
-
 def test_warm_start_errors(tmp_path):
     with pytest.raises(SceneError, match="case.warm_from"):
         paper(start="warm")

@@ -140,27 +140,6 @@ def test_divisible_sizes_give_the_plain_lattice(name):
     assert np.all(p.cell_volume == dp * dp)
 
 
-@pytest.mark.parametrize("rows", [18.57, 7.3, 3.5])
-def test_the_area_fill_keeps_a_profile_area_that_rounding_misses(rows):
-    """A nearly uniform depth of 18.57 rows: each column rounds to 19 (+2.3 %); the area fill
-    holds sum dx (top - base) to half a cell, each column within one row of its depth."""
-    from solver.layout import profile_lattice
-    from solver.scene import FluidProfile
-    dp, n = 1e-3, 200
-    tops = rows * dp * (1.0 + 0.002 * np.sin(np.arange(n + 1) / 7.0))
-    surface = [[k * dp, t] for k, t in enumerate(tops)]
-    target = np.interp((np.arange(n) + 0.5) * dp, *np.array(surface).T)
-    nearest = profile_lattice(FluidProfile(x=(0.0, n * dp), base=0.0, surface=surface), dp)
-    area = profile_lattice(FluidProfile(x=(0.0, n * dp), base=0.0, surface=surface, fill="area"), dp)
-    exact = target.sum() * dp
-    assert abs(area[0].size * dp * dp - exact) <= 0.5 * dp * dp + 1e-15
-    columns = np.round(area[0] / dp - 0.5).astype(int)
-    per_column = np.bincount(columns, minlength=n)
-    assert np.all(np.abs(per_column - target / dp) < 1.0)
-    if rows == 18.57:  # the plain rounding's bias that the area fill removes
-        assert nearest[0].size * dp * dp / exact - 1.0 > 0.015
-
-
 def test_stretched_points_fill_the_interval():
     xs, step = stretched_points(0.0, 0.057, 1.75e-3)
     assert xs.size == 33 and step == pytest.approx(0.057 / 33)
