@@ -21,7 +21,8 @@ every 0.1 s, whose mean toe lies beyond 1 dp of its mean.
 
 With --calibrate it checks the standard error of a window mean (solver/timeseries.py) against
 series whose window-to-window scatter is known. Synthetic: AR(1) series with correlation times
-0.1, 1 and 5 s and a slow wander (white noise plus an AR(1) of 2 s), sampled every 0.02 s, 3 s
+0.1, 1 and 5 s, a slow wander (white noise plus an AR(1) of 2 s) and a faint one (white noise
+plus 0.3 times an AR(1) of 3 s), sampled every 0.02 s, 3 s
 windows read with steady.context s of samples before them; ratio: the RMS reported se over the
 true standard deviation of the window mean (over --series series). Real: front runs carried on
 far past steady (by default examples/conveyor_fast.yaml at dp = 1.5 mm, each shifting method,
@@ -201,13 +202,15 @@ def ar1(n: int, dt: float, tau: float, rng, rows: int) -> np.ndarray:
 
 def synthetic_ratio(kind: str, context: float, rows: int, seed: int = 0) -> tuple[float, float]:
     """(RMS reported se / sd of the window means, the same for the slope) over ``rows`` series
-    of ``kind`` ('ar1 TAU' or 'wander'), one window each, read with ``context`` s before it."""
+    of ``kind`` ('ar1 TAU', 'wander' or 'faint'), one window each, read with ``context`` s before it."""
     from solver.timeseries import window_fits
     rng = np.random.default_rng(seed)
     n_w, n_c = round(WINDOW / DT), round(context / DT)
     n = n_w + n_c
     if kind == "wander":
         y = 0.5 * rng.standard_normal((rows, n)) + ar1(n, DT, 2.0, rng, rows)
+    elif kind == "faint":
+        y = rng.standard_normal((rows, n)) + 0.3 * ar1(n, DT, 3.0, rng, rows)
     else:
         y = ar1(n, DT, float(kind.split()[1]), rng, rows)
     t = np.arange(n) * DT
@@ -287,9 +290,10 @@ def calibrate(a) -> str:
     print(f"## The se of a {WINDOW:g} s window mean, read with {context:g} s of samples before the window\n")
     print("### Synthetic series (probe interval 0.02 s)\n")
     rows = []
-    for kind in ("ar1 0.1", "ar1 1", "ar1 5", "wander"):
+    names = {"wander": "white noise + AR(1) of 2 s", "faint": "white noise + 0.3 x AR(1) of 3 s"}
+    for kind in ("ar1 0.1", "ar1 1", "ar1 5", "wander", "faint"):
         r_m, r_b = synthetic_ratio(kind, context, a.series)
-        name = f"AR(1), tau = {kind.split()[1]} s" if kind != "wander" else "white noise + AR(1) of 2 s"
+        name = names.get(kind) or f"AR(1), tau = {kind.split()[1]} s"
         rows.append([name, f"{r_m:.2f}", f"{r_b:.2f}"])
     print(common.table(["series", "se / sd of the mean", "se / sd of the slope"], rows))
     pooled = {}

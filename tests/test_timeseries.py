@@ -1,6 +1,6 @@
 """The standard error of a window mean and slope (solver/timeseries.py) against the known scatter
-of synthetic series: AR(1) with correlation times 0.1, 1 and 5 s, and a slow wander under
-white noise, sampled as the probes are (0.02 s), a 3 s window read with the shipped context."""
+of synthetic series: AR(1) with correlation times 0.1, 1 and 5 s, and a slow wander (strong
+or faint) under white noise, sampled as the probes are (0.02 s), a 3 s window read with the shipped context."""
 import math
 
 import numpy as np
@@ -35,6 +35,16 @@ def test_slow_wander_under_white_noise_is_calibrated():
     rng = np.random.default_rng(12)
     n_c, n_w = round(Steady().context / DT), round(WINDOW / DT)
     y = 0.5 * rng.standard_normal((SERIES, n_c + n_w)) + ar1(n_c + n_w, DT, 2.0, rng, SERIES)
+    r_mean, r_slope = _ratios(y, n_c)
+    assert 0.7 <= r_mean <= 1.4 and 0.7 <= r_slope <= 1.4, (r_mean, r_slope)
+
+
+def test_faint_slow_wander_under_white_noise_is_calibrated():
+    """White noise (sd 1) over 0.3 times an AR(1) of 3 s, a near-front velocity's make-up: the se
+    of the window mean within 0.7-1.4 (a sum stopped inside the noise's correlation reads 0.56)."""
+    rng = np.random.default_rng(15)
+    n_c, n_w = round(Steady().context / DT), round(WINDOW / DT)
+    y = rng.standard_normal((SERIES, n_c + n_w)) + 0.3 * ar1(n_c + n_w, DT, 3.0, rng, SERIES)
     r_mean, r_slope = _ratios(y, n_c)
     assert 0.7 <= r_mean <= 1.4 and 0.7 <= r_slope <= 1.4, (r_mean, r_slope)
 
