@@ -14,18 +14,18 @@ event inside the window is judged against what came before it). gamma_k = sum_i 
 is low by about 2 V / N, V = gamma_0 + 2 sum_{k<=M} gamma_k the long-run variance, because the
 line was fitted to the same samples; each gamma_k is raised by that, V solved for with it,
 V = V_raw / (1 - 2 (2M + 1) / N). The sum stops at Sokal's window M, the smallest lag with
-M >= C tau(M), tau(M) = V / gamma_0, M < n, and before the correction exceeds MAX_CORRECTION.
-C = 20, not emcee.autocorr's 5: a probe series is particle noise, correlated over a sample or
-two, over a faint wander of seconds (a near-front velocity: 9 % of the variance, each lag's
-autocorrelation about 0.08 out past 1 s). With C = 5 the sum stops inside the noise's
-correlation and misses the wander's share of the mean's variance: white noise plus 0.3 times
-an AR(1) of 3 s reads 0.56 of the true se with C = 5 and 0.93 with C = 20. A variance below FLOOR times the uncorrelated
+M >= C tau(M), tau(M) = V / gamma_0 (C = 5, as emcee.autocorr.integrated_time), M < n, and
+before the correction exceeds MAX_CORRECTION. A variance below FLOOR times the uncorrelated
 series' (anticorrelated samples) is raised to it.
 
 A window alone cannot see a correlation as long as itself: callers pass up to
 ``steady.context`` s of samples before it (solver/steady.py, study/metrics.py). A context of a
 few seconds still reads a 1 s correlation short (the se low by about half with 3 s), and a
-transient inside the context widens the se until it leaves it.
+transient inside the context widens the se until it leaves it. Particle noise over a faint
+wander of seconds (white noise plus 0.3 times an AR(1) of 3 s) stops the sum inside the noise's
+correlation and reads the se of the mean at 0.55 of its scatter. C = 20 reads it at 0.93 but
+the se of white noise over a 1 s window alone at 0.58, and of the toe's one-second slope at
+0.76, so C stays 5.
 """
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ import math
 import numba as nb
 import numpy as np
 
-C_SOKAL = 20.0  # Sokal's window: the autocorrelation is summed to M >= C tau(M) (module docstring)
+C_SOKAL = 5.0  # Sokal's window: the autocorrelation is summed to M >= C tau(M)
 LINE_BIAS = 2.0  # residuals about a fitted line: gamma_k is low by about 2 V / N (module docstring)
 FLOOR = 0.25  # a variance is at least this fraction of the uncorrelated series' (anticorrelated samples)
 MAX_CORRECTION = 4.0  # the window stops before the correction 1 / (1 - 2 (2M + 1) / N) exceeds this
