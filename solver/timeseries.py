@@ -23,9 +23,7 @@ A window alone cannot see a correlation as long as itself: callers pass up to
 few seconds still reads a 1 s correlation short (the se low by about half with 3 s), and a
 transient inside the context widens the se until it leaves it. Particle noise over a faint
 wander of seconds (white noise plus 0.3 times an AR(1) of 3 s) stops the sum inside the noise's
-correlation and reads the se of the mean at 0.55 of its scatter. C = 20 reads it at 0.93 but
-the se of white noise over a 1 s window alone at 0.58, and of the toe's one-second slope at
-0.76, so C stays 5.
+correlation and reads the se of the mean at 0.55 of its scatter (docs/metrics.md).
 """
 from __future__ import annotations
 
