@@ -32,7 +32,9 @@ metrics fold: the toe's velocity over the window's last second (zeta_f), the uni
 (zeta_h), the influence series of zeta_fs and of each station's zeta_u linearised about the
 run's mean (study.metrics.metric_series), and every component of the surface and the station
 profiles the steady detection reads. Ratio: RMS se over the standard deviation of the window
-means, per metric, pooled over its components and the runs. --quick: synthetic series only.
+means, per metric, pooled over its components and the runs. Then zeta_u itself at each
+station: its reported se (study.metrics) over the scatter of its values over those windows.
+--quick: synthetic series only.
 
     python -m benchmarks.window_metrics --calibrate [RUN.nc ...] [--skip 20] [--series 2000]
 """
@@ -267,6 +269,25 @@ def real_components(run: xr.Dataset, skip: float, context: float) -> dict:
     return {k: (np.array(a, dtype=float), np.array(b, dtype=float)) for k, (a, b) in out.items()}
 
 
+def station_values(paths, skip: float) -> list[list[str]]:
+    """Per run and station: zeta_u and its reported se (study.metrics, each window with its
+    context) over the run's non-overlapping windows from ``skip`` on, and the ratio of the RMS se
+    to the standard deviation of the values (RMS values fold near zero: read where zeta_u is
+    well above its scatter)."""
+    rows = []
+    for path in paths:
+        with xr.open_dataset(path) as ds:
+            run = ds.load()
+        values = table(run, WINDOW, WINDOW, skip)
+        for s in run["station"].values:
+            v = np.array([r[f"zeta_u_{s:g}"] for r in values])
+            e = np.array([r[f"zeta_u_{s:g}_se"] for r in values])
+            ok = np.isfinite(v) & np.isfinite(e)
+            sd, rms = np.std(v[ok], ddof=1), math.sqrt(np.mean(e[ok] ** 2))
+            rows.append([Path(path).name, f"{s:g}", str(int(ok.sum())), f"{sd:.4f}", f"{rms:.4f}", f"{rms / sd:.2f}"])
+    return rows
+
+
 def ratio(means: np.ndarray, ses: np.ndarray) -> tuple[float, int]:
     """(RMS se / RMS sd of the window means, pooled over the components with a finite se in
     every window and a nonzero scatter; how many components)."""
@@ -314,6 +335,9 @@ def calibrate(a) -> str:
             se2 = sum(np.mean(se[:, u] ** 2, axis=0).sum() for (_, se), u in zip(parts, use))
             rows.append(["pooled", k, "", "", f"{math.sqrt(se2 / sd2):.2f}"])
         print(common.table(["run", "metric", "windows", "components", "se / sd"], rows))
+        print("\n### zeta_u itself: its reported se over the scatter of its values, one a window\n")
+        print(common.table(["run", "station x*", "windows", "sd of zeta_u", "RMS se", "se / sd"],
+                           station_values(a.runs, a.skip)))
         metrics = [r for r in rows if r[0] == "pooled" and r[1].startswith("zeta")]
         return ("se / sd of a window mean over the long runs' windows, pooled: "
                 + ", ".join(f"{r[1]} {r[4]}" for r in metrics))

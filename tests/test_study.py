@@ -398,6 +398,33 @@ def test_window_errors_are_the_scatter_about_the_line():
     assert 0.9 <= math.sqrt(np.mean(np.square(se))) / (0.002 / math.sqrt(51)) <= 1.35
 
 
+def test_an_rms_error_over_points_that_few_samples_define_has_the_se_of_its_scatter():
+    """A profile whose top 3 of 10 points lie inside the fluid in 10 % of the samples (as a
+    near-front station does at dp = 2.25 mm): each window's mean there is over its defining
+    samples alone, so the RMS error of 400 windows of 150 white-noise samples scatters with the
+    se of its influence series only where each point's deviation is weighted by 1 / (its
+    share of defining samples): RMS se over that scatter within 0.8-1.25 (measured 0.97;
+    0.29 unweighted, which the last assertion shows)."""
+    from solver.timeseries import window_fits
+    from study.metrics import _column_means, _defined_share, rms_influence
+    rng = np.random.default_rng(3)
+    nx, n = 10, 150
+    mu, ref = 0.2 + 0.05 * np.arange(nx), np.zeros(nx)
+    share = np.where(np.arange(nx) >= 7, 0.1, 1.0)
+    t = np.arange(n) * 0.02
+    zeta, se, se_unweighted = [], [], []
+    for _ in range(400):
+        c = mu + 0.3 * rng.standard_normal((n, nx))
+        c[rng.random((n, nx)) >= share] = np.nan
+        m = _column_means(c)
+        zeta.append(math.sqrt(np.mean((m - ref) ** 2)))
+        se.append(window_fits(t, rms_influence(ref, m, c, _defined_share(c)))[1][0])
+        se_unweighted.append(window_fits(t, rms_influence(ref, m, c))[1][0])
+    sd = np.std(zeta, ddof=1)
+    assert 0.8 <= math.sqrt(np.mean(np.square(se))) / sd <= 1.25
+    assert math.sqrt(np.mean(np.square(se_unweighted))) / sd < 0.5
+
+
 def test_window_errors_unknown_without_a_matching_record():
     """No record, too short a window, or a record whose window mean is not the stored one:
     the errors are NaN (unknown), never zero."""

@@ -8,7 +8,8 @@ Sampling errors (docs/metrics.md, "Standard errors"): each the se of a window me
 from its series' autocorrelation over the samples before the window (solver.timeseries):
 zeta_f's of the toe's slope over its second (``zeta_f_error``); zeta_h's of the uniform depth's
 mean; zeta_fs's and zeta_u's of the mean of their influence series, the RMS linearised about
-the window's mean curve (``rms_influence``, ``window_errors``).
+the window's mean curve, each point weighted by the share of samples that define it
+(``rms_influence``, ``window_errors``).
 
 beyond the paper, a diagnostic beside zeta_f: zeta_f_body, the same error of the equivalent front
 (``front_body_velocity_error``), which tells a front that moves from a toe that wanders.
@@ -171,11 +172,14 @@ def _on_reference(x_ref, x_run, rows) -> np.ndarray:
     return np.array([on_abscissas(x_ref, x_run, r) for r in rows]).reshape(len(rows), np.size(x_ref))
 
 
-def rms_influence(reference: np.ndarray, mean_curve: np.ndarray, curves: np.ndarray) -> np.ndarray:
+def rms_influence(reference: np.ndarray, mean_curve: np.ndarray, curves: np.ndarray,
+                  defined: np.ndarray | None = None) -> np.ndarray:
     """The first-order change of the RMS error sqrt(mean_x (c_x - r_x)^2) about the mean curve
-    when the curve is one sample's: sum_x d_x (c_x(t) - cbar_x) / (N_x rms), d = cbar - r, over the
-    abscissas where the mean curve and the reference are defined (a sample's undefined points
-    count as the mean's). Its window mean's se is the RMS error's (delta method)."""
+    when the curve is one sample's: sum_x d_x (c_x(t) - cbar_x) / (p_x N_x rms), d = cbar - r,
+    over the abscissas where the mean curve and the reference are defined; a sample's undefined
+    points count as the mean's. p_x (``defined``, default 1) is the share of the window's samples
+    that define point x: cbar_x is their mean alone (a ratio estimator), so each one moves it by
+    1 / (p_x n) of its deviation. Its window mean's se is the RMS error's (delta method)."""
     d = mean_curve - reference
     ok = np.isfinite(d)
     if not ok.any():
@@ -184,14 +188,23 @@ def rms_influence(reference: np.ndarray, mean_curve: np.ndarray, curves: np.ndar
     if rms == 0.0:
         return np.zeros(len(curves))
     dev = np.where(np.isfinite(curves[:, ok]), curves[:, ok] - mean_curve[ok], 0.0)
+    if defined is not None:  # a point no sample defines has no deviation to weight
+        share = defined[ok]
+        dev = np.divide(dev, share, out=np.zeros_like(dev), where=share > 0.0)
     return dev @ d[ok] / (ok.sum() * rms)
+
+
+def _defined_share(rows: np.ndarray) -> np.ndarray:
+    """The share of ``rows`` (samples, points) finite at each point."""
+    return np.isfinite(rows).mean(axis=0) if len(rows) else np.ones(rows.shape[1])
 
 
 def metric_series(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, samples: np.ndarray,
                   x_star_range=(0.0, 12.0)) -> tuple[np.ndarray, np.ndarray]:
     """Over ``samples``: the uniform depth / h_n (column 0), the influence series of zeta_fs
     (column 1) and of zeta_u at each station (columns 2...), linearised about the means over the
-    window ``idx`` (``rms_influence``): (time, series)."""
+    window ``idx``, each point weighted by the share of the window's samples that define it
+    (``rms_influence``): (time, series)."""
     hn = float(run.attrs["h_n_m"])
     lo, hi = x_star_range
     ref_s = ref["surface"].sel(x_star=slice(lo, hi))
@@ -199,13 +212,14 @@ def metric_series(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, samples: np
     surf = run["surface_elevation"].values / hn
     cols = [run["uniform_depth"].values[samples] / hn,
             rms_influence(ref_s.values, on_abscissas(xr_, xs, _column_means(surf[idx])),
-                          _on_reference(xr_, xs, surf[samples]))]
+                          _on_reference(xr_, xs, surf[samples]), _defined_share(_on_reference(xr_, xs, surf[samples])))]
     vel, z = run["velocity_star"], run["z_star"].values
     for s in ref["station"].values:
         ref_u = ref["velocity"].sel(station=s)
+        zr = ref_u["z_star"].values
         v = vel.sel(station=s, method="nearest").values
-        cols.append(rms_influence(ref_u.values, on_abscissas(ref_u["z_star"].values, z, _column_means(v[idx])),
-                                  _on_reference(ref_u["z_star"].values, z, v[samples])))
+        cols.append(rms_influence(ref_u.values, on_abscissas(zr, z, _column_means(v[idx])),
+                                  _on_reference(zr, z, v[samples]), _defined_share(_on_reference(zr, z, v[samples]))))
     return run["time"].values[samples], np.array(cols)
 
 
