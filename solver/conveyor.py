@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import lubrication, schemes, viscoplastic
+from .layout import support_layers
 from .scene import (SHIFTING_METHODS, Numerics, Scene, SceneError, YamlData, parse_into, refuse_moved_keys,
                     scene_from_dict)
 from .steady import SteadyCriteria
@@ -304,8 +305,8 @@ def validate_case(c: ConveyorCase) -> None:
 
 
 def wall_thickness(c: ConveyorCase) -> float:
-    """Whole number of dp covering the kernel support 2h."""
-    return math.ceil(2.0 * c.ch - 1e-9) * c.dp
+    """The belt's depth: the layers within the kernel support of the fluid (layout.support_layers)."""
+    return support_layers(c.ch * c.dp, c.dp) * c.dp
 
 
 def scheme_fluid(c: ConveyorCase, flux_ratio: float) -> ConveyorCase:

@@ -5,9 +5,9 @@ L / n apart along each side (``stretched_points``), so the fluid's area is the s
 dp is. Each wall is laid from its fluid faces, away from the fluid: the layer nearest a face that fluid
 lies beyond sits dp / 2 inside it, hence dp from the fluid lattice of a block that touches the
 face (within dp / (4n) of it), and layers go on away from the fluid for the stated thickness or
-for the kernel support 2h, whichever is deeper (``laid_walls``). Where every size is a whole
-number of dp and walls are at least 2h thick, every position is the plain lattice
-lo + (i + 1/2) dp, bit for bit.
+for every layer a fluid particle can reach, whichever is deeper (``laid_walls``,
+``support_layers``). Where every size is a whole number of dp and walls are at least that
+thick, every position is the plain lattice lo + (i + 1/2) dp, bit for bit.
 """
 from __future__ import annotations
 
@@ -18,6 +18,20 @@ from typing import NamedTuple
 import numpy as np
 
 SAME = 1e-9  # relative tolerance within which a length counts as a whole number of spacings
+# the closest a fluid particle comes to a wall face, in dp: its lattice starts dp / 2 off the
+# face and the wall's density keeps it off (0.13 dp at the least, the toe on the belt during the
+# conveyor's start-up at dp = 2.25 mm, tests/test_conveyor.py)
+FLUID_STANDOFF = 0.1
+
+
+def support_layers(h: float, dp: float) -> int:
+    """Wall layers, dp apart from dp / 2 inside the face, that lie within the kernel support 2h
+    of a fluid particle FLUID_STANDOFF dp off the face: ceil(2h / dp - 1/2 - FLUID_STANDOFF).
+    A deeper layer is outside the support of every fluid particle further off the face, so it
+    would change no sum (3 layers at h / dp = 1.8, where 2h / dp = 3.6 rounds up to 4); a
+    particle closer than that sees it at q >= 2 - FLUID_STANDOFF dp / h, where W is below
+    3e-5 of W(0) (h >= dp)."""
+    return math.ceil(2.0 * h / dp - 0.5 - FLUID_STANDOFF - SAME)
 
 
 class LayoutError(ValueError):
@@ -99,7 +113,7 @@ def fluid_sides(wall, fluid: list, periodic) -> dict[int, tuple[bool, bool]]:
 @dataclass(frozen=True)
 class LaidWall:
     """A wall's particle region ``rect`` (the stated one, its far side moved to
-    max(round(T / dp), ceil(2h / dp)) dp from each fluid face, and its ends moved out to meet
+    max(round(T / dp), support_layers) dp from each fluid face, and its ends moved out to meet
     grown walls) and its columns ``xs`` and rows ``zs``, spacings ``dx`` and ``dz``."""
 
     rect: Extent
@@ -128,16 +142,16 @@ def _from_face(lo: float, hi: float, dp: float, layers: int, face_upper: bool):
 def laid_walls(scene) -> list[LaidWall]:
     """Every wall's particle lattice (module docstring), per axis:
 
-    - fluid beyond one side: layers dp apart from that face, max(round(T / dp), ceil(2h / dp))
+    - fluid beyond one side: layers dp apart from that face, max(round(T / dp), support_layers)
       of them (T the stated thickness), the extra ones away from the fluid;
     - fluid beyond both sides: the stated thickness filled (``stretched_points``);
     - fluid beyond neither (along the wall): the stated length filled, its ends first moved out
       to the outer side of any wall they meet there that grew (so that corners stay closed).
     Raises LayoutError naming the wall and dp where an extent holds no particle.
     """
-    dp, two_h = scene.dp, 2.0 * scene.h
+    dp = scene.dp
     fluid = scene.fluid.extents()
-    depth_layers = math.ceil(two_h / dp - SAME)
+    depth_layers = support_layers(scene.h, dp)
     sides = [fluid_sides(w, fluid, scene.periodic_x) for w in scene.walls]
     laid: list[dict] = []
     for i, w in enumerate(scene.walls):

@@ -46,7 +46,9 @@ def test_preset_geometry(start):
     assert belt.velocity == (-0.075, 0.0) and not belt.moving
     assert belt.ramp_delay == c.belt.rest and belt.ramp_time == c.belt.ramp
     assert upstream.velocity == (0.0, 0.0) and upstream.x[1] == 0.0
-    assert belt.z[1] == 0.0 and wall_thickness(c) >= 2 * scene.h
+    # the belt holds every layer within 2h of fluid a quarter dp above it, and no deeper one
+    layers = round(wall_thickness(c) / c.dp)
+    assert belt.z[1] == 0.0 and (layers - 0.25) * c.dp < 2 * scene.h <= (layers + 0.75) * c.dp
     assert belt.x[1] >= initial_toe(c) + c.belt.margin * c.h_n - 1e-12
     p = build_particles(scene)
     f = p.kind == 0
@@ -422,3 +424,29 @@ def test_surge_takes_c_cfl_0_6_where_the_depth_holds_15_particles_and_0_4_below(
     case = case_from_dict({"dp": dp, "ch": 1.8, "shifting": "lind"})
     assert (case.numerics.cfl, case.numerics.cfl_rule) == (cfl, "damping")
     assert case_from_dict({"dp": dp, "ch": 1.8, "numerics": {"cfl": 0.5}}).numerics.cfl == 0.5
+
+
+@pytest.mark.parametrize("start", ["block", "lubrication"])
+def test_the_belt_omits_no_layer_that_the_fluid_reaches(start):
+    """The walls hold only the layers within 2h of fluid FLUID_STANDOFF dp off their faces
+    (solver.layout.support_layers). Through the start-up (the block's collapse, or the film's
+    front forming; dp = 2.25 mm, Ch 1.8, to 1.5 s) the fluid's closest approach to the belt
+    (z = 0) and to the upstream wall (x = 0) stays beyond it (measured 0.19 and 0.13 dp to the
+    belt, 0.33 dp to the wall), so the first layer not laid is outside every fluid particle's
+    support: the kernel sum it would add to the closest particle, a row of particles dp apart
+    (L + 1/2) dp below the face, is 0."""
+    from solver.kernel import kernel
+    from solver.layout import FLUID_STANDOFF, support_layers
+    from solver.simulation import Simulation
+    case = coarse_conveyor_case(ch=1.8, start=start, start_velocity="rest" if start == "block" else "lubrication")
+    sim = Simulation(build_scene(case))
+    closest = math.inf
+    while sim.t < 1.5:
+        assert sim.step() == ""
+        f = sim.kind[: sim.n_active] == 0
+        closest = min(closest, float(sim.z[: sim.n_active][f].min()), float(sim.x[: sim.n_active][f].min()))
+    dp, h = case.dp, sim.h
+    assert closest >= FLUID_STANDOFF * dp, closest / dp
+    depth = (support_layers(h, dp) + 0.5) * dp + closest
+    row = np.arange(-10, 11) * dp
+    assert float(np.sum(kernel(np.hypot(row, depth), h))) * dp * dp == 0.0
