@@ -46,9 +46,9 @@ def test_preset_geometry(start):
     assert belt.velocity == (-0.075, 0.0) and not belt.moving
     assert belt.ramp_delay == c.belt.rest and belt.ramp_time == c.belt.ramp
     assert upstream.velocity == (0.0, 0.0) and upstream.x[1] == 0.0
-    # the belt holds every layer within 2h of fluid a quarter dp above it, and no deeper one
+    # the belt holds every layer within 2h of fluid a tenth of dp above it, and no deeper one
     layers = round(wall_thickness(c) / c.dp)
-    assert belt.z[1] == 0.0 and (layers - 0.25) * c.dp < 2 * scene.h <= (layers + 0.75) * c.dp
+    assert belt.z[1] == 0.0 and (layers - 0.4) * c.dp < 2 * scene.h <= (layers + 0.6) * c.dp
     assert belt.x[1] >= initial_toe(c) + c.belt.margin * c.h_n - 1e-12
     p = build_particles(scene)
     f = p.kind == 0

@@ -1,8 +1,7 @@
 """Scenes valid at any dp (docs/scene.md, "Particle layout"): every shipped scene without a period,
 built at spacings that do not divide its sizes, has its wall layers dp from the fluid, walls
-holding every layer within 2h of fluid a quarter dp off their faces, and its fluid area; where
+holding every layer within 2h of fluid a tenth of dp off their faces, and its fluid area; where
 the sizes divide dp the positions are the plain lattice."""
-import math
 from pathlib import Path
 
 import numpy as np
@@ -92,10 +91,10 @@ def test_every_scene_is_valid_at_spacings_that_divide_none_of_its_sizes(name):
         # least fluid-to-wall distance: dp, within 10 %
         d = np.array([np.min(np.hypot(bx - x, bz - z)) for x, z in zip(fx, fz)])
         assert 0.9 * dp <= d.min() <= 1.1 * dp, (name, dp, d.min() / dp)
-        # every wall layer within 2h of a fluid particle a quarter dp off the face (its layers
+        # every wall layer within 2h of a fluid particle a tenth of dp off the face (its layers
         # sit (l - 1/2) dp inside it): from each fluid particle next to a wall, towards its
         # nearest wall particle along the nearer axis, count contiguous layers
-        need = sum(1 for layer in range(1, 20) if (layer - 0.5 + 0.25) * dp < 2 * scene.h - 1e-12 * dp)
+        need = sum(1 for layer in range(1, 20) if (layer - 0.5 + 0.1) * dp < 2 * scene.h - 1e-12 * dp)
         touching = np.where(d < 1.1 * dp)[0]
         for k in touching[:: max(1, touching.size // 200)]:
             j = np.argmin(np.hypot(bx - fx[k], bz - fz[k]))
