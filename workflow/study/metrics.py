@@ -177,9 +177,10 @@ def rms_influence(reference: np.ndarray, mean_curve: np.ndarray, curves: np.ndar
     """The first-order change of the RMS error sqrt(mean_x (c_x - r_x)^2) about the mean curve
     when the curve is one sample's: sum_x d_x (c_x(t) - cbar_x) / (p_x N_x rms), d = cbar - r,
     over the abscissas where the mean curve and the reference are defined; a sample's undefined
-    points count as the mean's. p_x (``defined``, default 1) is the share of the window's samples
-    that define point x: cbar_x is their mean alone (a ratio estimator), so each one moves it by
-    1 / (p_x n) of its deviation. Its window mean's se is the RMS error's (delta method)."""
+    points count as the mean's. p_x (``defined``, default 1) is the chance that a sample defines
+    point x: cbar_x is the mean of the window's samples that do (a ratio estimator), so each one
+    moves it by 1 / (p_x n) of its deviation. Its window mean's se is the RMS error's (delta
+    method)."""
     d = mean_curve - reference
     ok = np.isfinite(d)
     if not ok.any():
@@ -203,7 +204,7 @@ def metric_series(run: xr.Dataset, ref: xr.Dataset, idx: np.ndarray, samples: np
                   x_star_range=(0.0, 12.0)) -> tuple[np.ndarray, np.ndarray]:
     """Over ``samples``: the uniform depth / h_n (column 0), the influence series of zeta_fs
     (column 1) and of zeta_u at each station (columns 2...), linearised about the means over the
-    window ``idx``, each point weighted by the share of the window's samples that define it
+    window ``idx``, each point weighted by the share of ``samples`` that define it
     (``rms_influence``): (time, series)."""
     hn = float(run.attrs["h_n_m"])
     lo, hi = x_star_range
