@@ -209,12 +209,12 @@ def set_shifting(data: dict, method: str | None) -> dict:
 def layer(particles: int = 40000, ch: float = 1.5, shifting: str | None = "none", sets=(), dp: float = 1.0e-3,
           rows: int = 100) -> dict:
     """The throughput layer: examples/film.yaml (the paper fluid on its 15.3 deg incline,
-    periodic, mDBC, density diffusion) ``rows`` dp deep on a 2h bed, as long as makes about
+    periodic, mDBC, density diffusion) ``rows`` dp deep on a bed stated one dp thick, which the
+    solver's layout deepens to the layers its kernel reaches, as long as makes about
     ``particles`` fluid and bed particles, its sound speed set by its own depth."""
     d = read_yaml(solver_root() / "examples" / "film.yaml")
-    bed = int(math.ceil(2 * ch))
-    length = int(round(particles / (rows + bed)))
-    L, H, T = length * dp, rows * dp, bed * dp
+    length = int(round(particles / (rows + 2.0 * ch)))  # the bed: about 2h deep
+    L, H, T = length * dp, rows * dp, dp
     d.update(name=f"layer-ch{ch:g}-{shifting}", dp=dp, ch=ch, periodic_x=[0.0, L],
              time={"end": 1.0, "output_interval": 1.0})
     d["fluid"]["blocks"] = [{"x": [0.0, L], "z": [0.0, H]}]
