@@ -387,7 +387,7 @@ def build_scene_dict(c: ConveyorCase, warm=None, flux_ratio: float = 1.0) -> dic
         surface = warm.surface() if warm is not None else front_surface(start)
         fluid = {"profiles": [{"x": [0.0, c.dp * math.floor(x_toe / c.dp)], "base": 0.0,
                                "surface": surface,
-                               "row_depth": None if warm is not None else start.h_n}]}
+                               "row_depth": warm.depth if warm is not None else start.h_n}]}
     return {
         "name": c.name,
         "dp": c.dp, "ch": c.ch,

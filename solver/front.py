@@ -106,6 +106,9 @@ class FrontMonitor:
         self.station_front: list[np.ndarray] = []  # equivalent front from each station's anchor
         self.x_anchor = math.nan  # x0 of the equivalent front, set at the first sample
         self.x_station_anchor = np.full(self.stations.size, math.nan)  # lab-fixed, at the first sample
+        # the last sample's free surface along the whole fluid, (x, z_max) in the lab frame: the
+        # shape a warm start at another dp fills (``warm.load``)
+        self.last_surface = (np.zeros(0), np.zeros(0))
 
     @property
     def t_steady(self) -> float:
@@ -179,7 +182,7 @@ class FrontMonitor:
                 "enclosed_area": enclosed, "station_u": station_u, "station_front": station_front,
                 "mass_area": mass_area, "number_density": number_density,
                 "zone_enclosed": zone_enclosed, "zone_mass": zone_mass, "disorder": disorder,
-                "surface": surface, "velocity": u_star}
+                "surface": surface, "velocity": u_star, "surface_line": (xs, zs)}
 
     def why_not_steady(self) -> str:
         """Which quantities drift beyond their allowance over the final window pair."""
@@ -211,6 +214,7 @@ class FrontMonitor:
         self.zone_mass.append(s["zone_mass"])
         self.disorder.append(s["disorder"])
         self.surface.append(s["surface"])
+        self.last_surface = s["surface_line"]
         self.velocity.append(s["velocity"])
         self.station_u.append(s["station_u"])
         self.station_front.append(s["station_front"])
@@ -297,6 +301,11 @@ class FrontMonitor:
         ds["film_slip"] = (("time",), slip, {
             "units": "1",
             "long_name": f"u* at the bed of the fitted profile at x* = {self.stations[far]:g} (0: no slip)"})
+        sx, sz = self.last_surface
+        ds["final_surface"] = (("surface_x",), np.asarray(sz, dtype=float), {
+            "units": "m", "long_name": "free surface z_max (C = 0.5 level) at the last probe sample, wall to toe"})
+        ds = ds.assign_coords(surface_x=("surface_x", np.asarray(sx, dtype=float),
+                                         {"units": "m", "long_name": "x of final_surface, lab frame"}))
         # the averaging window A and its hold-out B: with steady.stop, the first steady pair;
         # otherwise (fixed end time, or no steady pair by max_time) the pair ending at the last
         # sample, steady only if it passes; a record shorter than two windows averages its final

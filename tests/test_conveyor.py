@@ -282,6 +282,41 @@ def test_warm_start_fills_the_coarse_state(tmp_path):
     np.testing.assert_allclose(w, 0.01, atol=1e-12)
 
 
+def test_warm_start_fills_the_source_surface_and_holds_its_depth(tmp_path):
+    """A source run that records its C = 0.5 surface (``final_surface``) and uniform depth: the
+    fine lattice fills under that surface, not under its particles' column tops, and its rows
+    hold the depth exactly where the surface is flat, whatever the depth's ratio to the fine dp."""
+    depth, length, dp = 0.0413, 0.3, 2.0e-3  # 20.65 fine dp: rows of dp would round to 21
+    coarse_state(tmp_path / "coarse.nc", depth=0.04)
+    with xr.open_dataset(tmp_path / "coarse.nc") as ds:
+        src = ds.load()
+    sx = np.arange(0.5e-3, length, 1.0e-3)
+    src["final_surface"] = ("surface_x", np.full(sx.size, depth))
+    src = src.assign_coords(surface_x=sx)
+    src["uniform_depth"] = ("time", [depth])
+    src.to_netcdf(tmp_path / "surface.nc")
+    c = paper(start="warm", warm_from=str(tmp_path / "surface.nc"), dp=dp, ch=1.5)
+    from solver import warm
+    state = warm.load(c.warm_from)
+    assert state.depth == depth
+    p = build_particles(build_scene(c, state))
+    f = p.kind == 0
+    xf, zf = p.x[f], p.z[f]
+    rows = round(depth / dp)
+    dz = depth / rows
+    interior = xf < length - 4 * dp
+    cols = np.unique(np.round(xf[interior], 9))
+    assert cols.size > 100
+    # every interior column: `rows` rows dz apart, its top at the source depth to rounding
+    for x in cols[::10]:
+        z = np.sort(zf[np.isclose(xf, x)])
+        assert z.size == rows
+        assert z[-1] + 0.5 * dz == pytest.approx(depth, abs=1e-12)
+    # the fluid's volume is the area under the surface, to half a cell per column at the toe
+    volume = (p.mass[f] / p.rho[f]).sum()
+    assert volume == pytest.approx(depth * length, abs=2 * dp * dz)
+
+
 def test_warm_start_errors(tmp_path):
     with pytest.raises(SceneError, match="case.warm_from"):
         paper(start="warm")
@@ -302,6 +337,12 @@ def test_warm_start_from_a_diverged_run_falls_back_to_a_cold_start(tmp_path):
     assert ds.attrs["warm_start"].startswith("fallback to the scheme's start (lubrication)")  # spec's
     assert "diverged" in ds.attrs["warm_start"]
     assert "start: lubrication" in ds.attrs["case_yaml"]
+    # the run records the surface a warm start from it fills: its last sample's C = 0.5 level
+    # from wall to toe, which over the uniform zone is the last uniform depth (same probe)
+    x_star = (ds.toe_position.values[-1] - ds.surface_x.values) / c.h_n
+    assert ds.surface_x.values[0] < c.dp and x_star[-1] < 0.1
+    zone = (x_star >= c.probes.uniform_zone[0]) & (x_star <= c.probes.uniform_zone[1])
+    assert ds.final_surface.values[zone].mean() == pytest.approx(ds.uniform_depth.values[-1], rel=2e-3)
 
 
 def test_checkpoint_key_covers_case_solver_and_threads(monkeypatch):
