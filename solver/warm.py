@@ -7,8 +7,8 @@ particles enter C), or, in a run that lacks it, the top of each coarse particle 
 dp/2 (which a disordered top row puts low). Rows are spaced to hold the source's last uniform
 depth in a whole number of rows, so that the body starts at that depth, not rounded to the
 fine dp. Densities start hydrostatic as for any profile; velocities are the Shepard
-interpolation of the coarse fluid velocities, u(r) = sum_j u_j W(r - r_j) / sum_j W(r - r_j) with the coarse h.
-The belt runs at full speed from t = 0.
+interpolation of the coarse fluid velocities, u(r) = sum_j u_j W(r - r_j) / sum_j W(r - r_j)
+with the coarse h. The belt runs at full speed from t = 0.
 """
 from __future__ import annotations
 
