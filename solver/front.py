@@ -404,6 +404,9 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None, progress=
     used = math.isfinite(flux_ratio)
     scene = build_scene(case, state, flux_ratio if used else 1.0)
     parts = build_particles(scene)
+    if state is not None:  # the source's arrangement instead of the lattice
+        from . import warm as _warm
+        parts = _warm.carry_arrangement(parts, scene, state)
     f = parts.kind == 0
     if case.start_perturbation > 0.0:
         dx, dz = start_offsets(int(f.sum()), case.start_perturbation * case.dp, case.perturbation_seed)

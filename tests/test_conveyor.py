@@ -317,6 +317,50 @@ def test_warm_start_fills_the_source_surface_and_holds_its_depth(tmp_path):
     assert volume == pytest.approx(depth * length, abs=2 * dp * dz)
 
 
+def nearest_neighbour(x, z):
+    d = np.hypot(x[:, None] - x[None], z[:, None] - z[None])
+    np.fill_diagonal(d, np.inf)
+    return d.min(axis=1)
+
+
+def test_a_warm_start_carries_the_source_arrangement_at_the_finer_dp(tmp_path):
+    """The finer run's fluid is the source's body arrangement scaled to 1 / dp^2 and tiled:
+    the same nearest-neighbour statistics in units of dp, no pair closer than MIN_GAP dp, under
+    the surface and off the walls, holding the area under the surface; the walls unchanged."""
+    from solver import warm
+    dpc, length, depth = 4.0e-3, 0.3, 0.04
+    coarse_state(tmp_path / "coarse.nc", dp=dpc, length=length, depth=depth)
+    with xr.open_dataset(tmp_path / "coarse.nc") as ds:
+        src = ds.load()
+    jitter = np.random.default_rng(3).uniform(-0.2, 0.2, (2, src.sizes["particle"])) * dpc
+    src["x"] = src["x"] + jitter[0]
+    src["z"] = src["z"] + jitter[1]
+    sx = np.arange(1.0e-3, length, 2.0e-3)
+    src["final_surface"] = ("surface_x", np.full(sx.size, depth))
+    src = src.assign_coords(surface_x=sx)
+    src["uniform_depth"] = ("time", [depth])
+    src.to_netcdf(tmp_path / "disordered.nc")
+    c = paper(start="warm", warm_from=str(tmp_path / "disordered.nc"), dp=2.0e-3, ch=1.5)
+    state = warm.load(c.warm_from)
+    scene = build_scene(c, state)
+    lattice = build_particles(scene)
+    p = warm.carry_arrangement(lattice, scene, state)
+    f, lf = p.kind == 0, lattice.kind == 0
+    np.testing.assert_array_equal(p.x[~f], lattice.x[~lf])
+    np.testing.assert_array_equal(p.wall[~f], lattice.wall[~lf])
+    xf, zf = p.x[f], p.z[f]
+    assert (zf < depth).all() and (zf >= warm.MIN_GAP * c.dp).all() and (xf >= warm.MIN_GAP * c.dp).all()
+    nn = nearest_neighbour(xf, zf) / c.dp
+    assert nn.min() >= warm.MIN_GAP
+    block = (state.x >= 0.25 * length) & (state.x < 0.75 * length) & (state.z < depth - 1.5 * dpc)
+    nn_src = nearest_neighbour(state.x[block], state.z[block]) / dpc
+    # one particle per dp^2 to the seams' thinning, and the source's spacings, not a lattice's
+    assert p.cell_volume[0] == pytest.approx(c.dp ** 2, rel=0.03)
+    assert np.median(nn) == pytest.approx(np.median(nn_src), rel=0.03)
+    assert np.median(nn) < 0.97 and np.median(nearest_neighbour(lattice.x[lf], lattice.z[lf]) / c.dp) == pytest.approx(1.0)
+    assert (p.mass[f] / p.rho[f]).sum() == pytest.approx(scene.fluid.profiles[0].area, rel=1e-12)
+
+
 def test_warm_start_errors(tmp_path):
     with pytest.raises(SceneError, match="case.warm_from"):
         paper(start="warm")
