@@ -86,7 +86,7 @@ T_SIM = ["12.5"]  # s, every case: --t-sim's default before the entries below
 # (its grid runs; a warm-start check) and from the moving film (the campaign without warm starts;
 # a film-start check; Lind's not steady by its max_time, 20 s)
 T_SIM_MEASURED = ["skillen=10.68", "lind=10.94", "skillen-paper=10.68", "lind-paper=10.94",
-                  "skillen-warm=13.12", "lind-warm=16.68", "skillen-film=17.1", "lind-film=20"]
+                  "skillen-warm=10.16", "lind-warm=11.34", "skillen-film=17.1", "lind-film=20"]
 
 
 def t_sim_of(specs, method: str, dp: float) -> float:
