@@ -11,7 +11,7 @@ import numba as nb
 import numpy as np
 import xarray as xr
 
-from . import film_depth, film_fit, steady
+from . import film_depth, film_fit, steady, warm
 from .build import build_particles
 from .checkpoint import Checkpointer, run_key
 from .conveyor import ConveyorCase, build_scene, cold_start, lubrication_velocity, scheme_fluid, start_offsets
@@ -383,9 +383,8 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None, progress=
     warm_note = ""
     state = None
     if case.start == "warm":
-        from . import warm as _warm
         try:
-            state = _warm.load(case.warm_from)
+            state = warm.load(case.warm_from)
         except (OSError, ValueError) as exc:  # a diverged or missing source: the scheme's cold start
             warm_note = f"fallback to the scheme's start ({cold_start(case)}): {exc}"
             if not quiet:
@@ -405,8 +404,7 @@ def run_front(case: ConveyorCase, quiet: bool = True, checkpoint=None, progress=
     scene = build_scene(case, state, flux_ratio if used else 1.0)
     parts = build_particles(scene)
     if state is not None:  # the source's arrangement instead of the lattice
-        from . import warm as _warm
-        parts = _warm.carry_arrangement(parts, scene, state)
+        parts = warm.carry_arrangement(parts, scene, state)
     f = parts.kind == 0
     if case.start_perturbation > 0.0:
         dx, dz = start_offsets(int(f.sum()), case.start_perturbation * case.dp, case.perturbation_seed)

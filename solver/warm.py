@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import xarray as xr
 
+from .build import hydrostatic_density
 from .kernel import alpha_2d, w_value
 
 BLOCK = (0.25, 0.75)  # the body block: this share of the wall-to-toe length
@@ -115,9 +116,9 @@ def tiled_arrangement(state: WarmState, dp: float, length: float, height: float)
     scale = dp * math.sqrt(inside.sum() / ((x1 - x0) * top))
     bx, bz = (state.x[inside] - x0) * scale, state.z[inside] * scale
     width, depth = (x1 - x0) * scale, top * scale
-    xs = [bx + i * width for i in range(math.ceil(length / width))]
-    x = np.concatenate([np.concatenate(xs) for _ in range(math.ceil(height / depth))])
-    z = np.concatenate([np.tile(bz, len(xs)) + j * depth for j in range(math.ceil(height / depth))])
+    jz, ix = np.meshgrid(np.arange(math.ceil(height / depth)), np.arange(math.ceil(length / width)), indexing="ij")
+    x = (bx[None] + width * ix.reshape(-1, 1)).ravel()  # tiles along x, then the next row of tiles
+    z = (bz[None] + depth * jz.reshape(-1, 1)).ravel()
     keep = (x <= length) & (z <= height)
     x, z = x[keep], z[keep]
     keep = _spaced(x, z, MIN_GAP * dp)
@@ -145,7 +146,6 @@ def carry_arrangement(parts, scene, state: WarmState):
     densities hydrostatic below that surface; each particle's volume the profile's area over
     their number (dp^2 but for the seams' thinning), so that the fluid holds that area; masses
     rho times it. Unchanged where the source gives no arrangement."""
-    from .build import hydrostatic_density
     profile = scene.fluid.profiles[0]
     dp = scene.dp
     length = profile.x[1]
