@@ -41,7 +41,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .cells import cell_of, neighbour_cell
+from .cells import cell_of, column_window, neighbour_cell, neighbour_column
 from .kernel import grad_coefficient
 
 
@@ -176,43 +176,62 @@ def near_surface(x, z, kind, surface, cl, n_active, h, near):
                         near[i] = 1
 
 
-@nb.njit(cache=True)
-def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, near, nx, nz):
-    """``near_surface``'s flags, and in the same pass (nx, nz)[i] = the unit vector along
-    sum_j (1 - q_ij/2)^4 n_j over the free-surface particles j within 2h of fluid particle i
-    (i itself included), n_j = -gradC_j / |gradC_j| their outward normals; zero where there is
-    none. Scattered from the surface particles, which are few: serial."""
+@nb.njit(inline="always", cache=True)
+def _scatter_normals(x, z, kind, surface, gcx, gcz, cl, h, near, nx, nz, cx):
+    """Add the normals of the free-surface particles of column cx to the fluid particles
+    within 2h (``surface_normals``); writes columns cx - 1 .. cx + 1 only."""
+    two_h = 2.0 * h
     four_h2 = 4.0 * h * h
     inv_h = 1.0 / h
-    for i in range(n_active):
-        near[i] = 0
-        nx[i] = 0.0
-        nz[i] = 0.0
-    for j in range(n_active):
+    for j in range(cl.start[cx * cl.ncz], cl.start[(cx + 1) * cl.ncz]):
         if not surface[j]:
             continue
         near[j] = 1
         g = math.sqrt(gcx[j] * gcx[j] + gcz[j] * gcz[j])
         ox, oz = (-gcx[j] / g, -gcz[j] / g) if g > 0.0 else (0.0, 0.0)
-        ix, iz = cell_of(cl, x[j], z[j])
+        zj = z[j]
+        iz = cell_of(cl, x[j], zj)[1]
         for ddx in range(-1, 2):
-            for ddz in range(-1, 2):
-                c, shift = neighbour_cell(cl, ix, iz, ddx, ddz)
-                if c < 0:
+            jx, shift = neighbour_column(cl, cx, ddx)
+            if jx < 0:
+                continue
+            i0, i1 = column_window(cl, z, jx, iz, zj - two_h)
+            for i in range(i0, i1):
+                ez = z[i] - zj
+                if ez >= two_h:
+                    break
+                if kind[i] != 0:
                     continue
-                for i in range(cl.start[c], cl.start[c + 1]):
-                    if kind[i] != 0:
-                        continue
-                    ex = x[i] + shift - x[j]
-                    ez = z[i] - z[j]
-                    r2 = ex * ex + ez * ez
-                    if r2 < four_h2:
-                        near[i] = 1
-                        s = 1.0 - 0.5 * math.sqrt(r2) * inv_h
-                        wgt = s * s * s * s
-                        nx[i] += wgt * ox
-                        nz[i] += wgt * oz
-    for i in range(n_active):
+                ex = x[i] + shift - x[j]
+                r2 = ex * ex + ez * ez
+                if r2 < four_h2:
+                    near[i] = 1
+                    s = 1.0 - 0.5 * math.sqrt(r2) * inv_h
+                    wgt = s * s * s * s
+                    nx[i] += wgt * ox
+                    nz[i] += wgt * oz
+
+
+@nb.njit(parallel=True, cache=True)
+def surface_normals(x, z, kind, surface, gcx, gcz, cl, n_active, h, near, nx, nz):
+    """``near_surface``'s flags, and in the same pass (nx, nz)[i] = the unit vector along
+    sum_j (1 - q_ij/2)^4 n_j over the free-surface particles j within 2h of fluid particle i
+    (i itself included), n_j = -gradC_j / |gradC_j| their outward normals; zero where there is
+    none. Scattered from the surface particles of each grid column (the column they were
+    sorted into) to the neighbouring columns, in parallel over columns three apart, which
+    write disjoint columns (the last ncx mod 3 columns each alone: a periodic x wraps)."""
+    for i in nb.prange(n_active):
+        near[i] = 0
+        nx[i] = 0.0
+        nz[i] = 0.0
+    ncx = cl.ncx
+    coloured = ncx - ncx % 3
+    for colour in range(3):
+        for k in nb.prange(coloured // 3):
+            _scatter_normals(x, z, kind, surface, gcx, gcz, cl, h, near, nx, nz, colour + 3 * k)
+    for cx in range(coloured, ncx):
+        _scatter_normals(x, z, kind, surface, gcx, gcz, cl, h, near, nx, nz, cx)
+    for i in nb.prange(n_active):
         nn = math.sqrt(nx[i] * nx[i] + nz[i] * nz[i])
         if nn > 0.0:
             nx[i] /= nn

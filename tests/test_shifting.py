@@ -4,6 +4,7 @@ import math
 import numpy as np
 import pytest
 
+from solver import shifting
 from solver.build import build_particles
 
 from solver.run import run_scene
@@ -279,3 +280,33 @@ def test_lind_tangential_leaves_the_surface_at_a_wall_alone():
     assert at_wall.sum() > 10 and under.sum() > 10
     assert not (moved & at_wall).any()
     assert (moved & under).sum() > 0.5 * under.sum()
+
+
+def test_surface_normals_are_the_weighted_mean_of_the_nearby_surface_normals():
+    """``surface_normals`` against its definition summed over every pair (periodic in x): near[i]
+    = a free-surface particle within 2h of fluid particle i, n_i along sum_j (1 - q_ij/2)^4 n_j
+    over those j, n_j = -gradC_j / |gradC_j|; on a disordered film 6 dp deep, whose surface
+    normals point up."""
+    r = shifted_thin_film(6, "tangential")
+    sim = r["sim"]
+    n, h = sim.n_active, sim.h
+    sl = sim.slots
+    gcx, gcz = sim.out[sl.GCX], sim.out[sl.GCZ]
+    shifting.surface_normals(sim.x, sim.z, sim.kind, sim.surface_flag, gcx, gcz, sim.cells, n, h,
+                             sim.near_flag, sim.surface_nx, sim.surface_nz)
+    fluid = sim.kind[:n] == 0
+    surf = np.flatnonzero((sim.surface_flag[:n] == 1) & fluid)
+    dx = sim.x[:n, None] - sim.x[surf][None, :]
+    dx -= sim.grid.period * np.round(dx / sim.grid.period)
+    q = np.hypot(dx, sim.z[:n, None] - sim.z[surf][None, :]) / h
+    w = np.where(q < 2.0, (1.0 - 0.5 * q) ** 4, 0.0)
+    g = np.hypot(gcx[surf], gcz[surf])
+    sx, sz = w @ (-gcx[surf] / g), w @ (-gcz[surf] / g)
+    norm = np.maximum(np.hypot(sx, sz), 1e-300)
+    near = (q < 2.0).any(axis=1) & fluid
+    assert surf.size > 15 and 0 < near.sum() < fluid.sum()
+    np.testing.assert_array_equal(sim.near_flag[:n] == 1, near)
+    np.testing.assert_allclose(sim.surface_nx[:n][near], (sx / norm)[near], atol=1e-12)
+    np.testing.assert_allclose(sim.surface_nz[:n][near], (sz / norm)[near], atol=1e-12)
+    assert (sim.surface_nx[:n][~near] == 0).all() and (sim.surface_nz[:n][~near] == 0).all()
+    assert np.median(sim.surface_nz[:n][near]) > 0.95
