@@ -33,8 +33,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="exit 0 when a diverged (or, for front, unsteady) run was written (campaigns record it)")
     w = sub.add_parser("warm", help="compile and cache every numba kernel (before parallel jobs)")
     w.add_argument("cases", nargs="*", default=[],
-                   help="front case files or scenes whose settings to compile as well (a case at a coarse dp, "
-                        "a scene as it is)")
+                   help="front case files or scenes (or files holding a list of them) whose kernels to compile "
+                        "(a case at a coarse dp, a scene as it is); none: a generic set")
     w.add_argument("--touch", default=None, help="file to create when done")
     return ap
 
@@ -144,59 +144,16 @@ def _front(args) -> int:
 
 
 def _warm(args) -> int:
-    """Step a tiny belt case with every shifting method, diffusion on and off (unless every
-    given file is a scene), each given case's own settings at a coarse dp (h_n / 5) and each
-    given scene as it is, so that the numba cache holds the kernels
-    the campaign needs before parallel jobs start."""
-    import json
-    import time
-    from .conveyor import build_scene, case_from_dict
-    from .front import FrontMonitor
-    from .simulation import Simulation
-    from .scene import read_yaml, scene_from_dict
-
-    def step_twice(case, boundary=None):
-        d = build_scene(case).to_dict()
-        if boundary:
-            d["numerics"]["boundary"] = boundary
-        sim = Simulation(scene_from_dict(d))
-        for _ in range(2):
-            sim.step()
-        FrontMonitor(case)(sim)
-
-    tic = time.perf_counter()
-    scenes_only = bool(args.cases) and all(_conveyor_case(p)[0] is None for p in args.cases)
-    for shifting in () if scenes_only else ("none", "skillen", "lind"):
-        for diffusion in (0.1, None):
-            case = case_from_dict({"dp": 0.004, "ch": 1.5, "shifting": shifting,
-                                   "numerics": {"density_diffusion": diffusion}})
-            for boundary in ("mdbc", "dbc"):
-                step_twice(case, boundary)
-    seen = set()
+    """Compile the kernels of the given case and scene files (a file may hold a list of them),
+    or without files a generic set (``solver.precompile``)."""
+    from .precompile import compile_kernels
+    from .scene import read_yaml
+    entries = []
     for path in args.cases:
-        d = read_yaml(path)
-        if _conveyor_case(path)[0] is None:  # a scene: its own kernels, stepped as it is
-            scene = scene_from_dict(d)
-            fluid = {k: v for k, v in d["fluid"].items() if k not in ("blocks", "profiles")}
-            key = json.dumps([d.get("numerics"), fluid, d.get("periodic_x") is not None], sort_keys=True)
-            if key not in seen:
-                seen.add(key)
-                sim = Simulation(scene)
-                for _ in range(2):
-                    sim.step()
-            continue
-        d.pop("warm_from", None)
-        if d.get("start") == "warm":
-            d["start"] = "lubrication"
-        case = case_from_dict(d)
-        coarse = case_from_dict({**d, "dp": max(case.dp, case.h_n / 5)})
-        scene = build_scene(coarse).to_dict()
-        fluid = {k: v for k, v in scene["fluid"].items() if k not in ("blocks", "profiles")}
-        key = json.dumps([scene["numerics"], fluid], sort_keys=True)  # what selects the kernels
-        if key not in seen:
-            seen.add(key)
-            step_twice(coarse)
-    print(f"numba kernels compiled and cached in {time.perf_counter() - tic:.1f} s", file=sys.stderr)
+        data = read_yaml(path)
+        entries += data if isinstance(data, list) else [data]
+    seconds = compile_kernels(entries)
+    print(f"numba kernels compiled and cached in {seconds:.1f} s", file=sys.stderr)
     if args.touch:
         from pathlib import Path
         Path(args.touch).parent.mkdir(parents=True, exist_ok=True)

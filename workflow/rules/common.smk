@@ -61,6 +61,12 @@ wildcard_constraints:
     case=CASE_ID,
 
 
+# Every case's solver settings in one file, for the kernels' compilation, which then starts with
+# the first job instead of after every case file.
+KERNEL_CASES = f"{R}/kernel_cases.yaml"
+_write_if_changed(KERNEL_CASES, yaml.safe_dump([FLOW.case_dict(config, c) for c in CASES], sort_keys=True))
+
+
 def case_yaml(wildcards):
     """The solver file of one case: a param, so only its own settings rerun it."""
     return yaml.safe_dump(FLOW.case_dict(config, CASE_BY_ID[wildcards.case]), sort_keys=True)

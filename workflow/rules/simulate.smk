@@ -1,6 +1,6 @@
 rule compile_kernels:
     input:
-        expand(f"{R}/cases/{{case}}/case.yaml", case=CASE_IDS),  # their settings are compiled too
+        KERNEL_CASES,
     output:
         touch(f"{R}/.kernels_compiled"),
     log:
