@@ -85,8 +85,8 @@ T_SIM = ["12.5"]  # s, every case: --t-sim's default before the entries below
 # start checks; the grid's own start at that dp, and a paper-start check), warm from dp = 1.5 mm
 # (its grid runs; a warm-start check) and from the moving film (the campaign without warm starts;
 # a film-start check; Lind's not steady by its max_time, 20 s)
-T_SIM_MEASURED = ["skillen=10.68", "lind=10.94", "skillen-paper=10.68", "lind-paper=10.94",
-                  "skillen-warm=10.16", "lind-warm=11.34", "skillen-film=17.1", "lind-film=20"]
+T_SIM_MEASURED = ["skillen=10.68", "lind=10.04", "skillen-paper=10.68", "lind-paper=10.04",
+                  "skillen-warm=10.16", "lind-warm=11.46", "skillen-film=17.1", "lind-film=20"]
 
 
 def t_sim_of(specs, method: str, dp: float) -> float:

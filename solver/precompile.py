@@ -5,9 +5,10 @@ A conveyor case is run as its runs are, at a coarse dp (h_n / 5) for 0.05 s of s
 time: the start (the film of a lubrication start), the steps, the probes, the steady
 detection and the NetCDF output; a warm-started case then runs once more from that run's
 file (the carried arrangement and the interpolated velocities); the disorder probe and a
-sub-stepped viscous update over several RKC stages are called directly. A scene is stepped twice as it is.
-Cases and scenes that select the same kernels are compiled once. With no case or scene given,
-a tiny belt case with every shifting method, diffusion on and off, and both boundaries.
+sub-stepped viscous update over several RKC stages are called directly. A scene is stepped
+twice as it is. Cases and scenes that select the same kernels are compiled once. With no case
+or scene given, a tiny belt case with every shifting method, diffusion on and off, and both
+boundaries.
 """
 from __future__ import annotations
 
@@ -53,19 +54,29 @@ def _beyond_the_coarse_run(scene) -> None:
                              sim.solver_work)
 
 
-def _conveyor(data: dict, folder: Path) -> None:
-    from .conveyor import build_scene, case_from_dict
-    from .front import run_front
+def _cold(data: dict) -> dict:
+    """A case dict without its warm start (a warm start's kernels are those of its cold start)."""
     data = {k: v for k, v in data.items() if k != "warm_from"}
-    warm = data.get("start") == "warm"
-    if warm:
+    if data.get("start") == "warm":
         data["start"] = "lubrication"
+    return data
+
+
+def _coarse(data: dict, **keys):
+    """The case at its coarse dp (h_n / COARSE_HN, or its own where coarser), ``keys`` set."""
+    from .conveyor import case_from_dict
+    data = _cold(data)
     case = case_from_dict(data)
-    steady = {**(data.get("steady") or {}), "max_time": RUN_TIME}
-    coarse = case_from_dict({**data, "dp": max(case.dp, case.h_n / COARSE_HN), "steady": steady})
+    return case_from_dict({**data, "dp": max(case.dp, case.h_n / COARSE_HN), **keys})
+
+
+def _conveyor(data: dict, folder: Path) -> None:
+    from .conveyor import build_scene
+    from .front import run_front
+    coarse = _coarse(data, steady={**(data.get("steady") or {}), "max_time": RUN_TIME})
     source = folder / "source.nc"
     run_front(coarse).to_netcdf(source)
-    if warm:
+    if data.get("start") == "warm":
         run_front(replace(coarse, start="warm", warm_from=str(source)))
     _beyond_the_coarse_run(build_scene(coarse))
 
@@ -80,7 +91,7 @@ def _generic() -> list[dict]:
 def compile_kernels(entries: list[dict]) -> float:
     """Compile the kernels of each conveyor case dict and scene dict in ``entries`` (module
     docstring); none: the generic set. Returns the wall seconds taken."""
-    from .conveyor import build_scene, case_from_dict
+    from .conveyor import build_scene
     from .scene import scene_from_dict
     tic = time.perf_counter()
     seen = set()
@@ -94,11 +105,7 @@ def compile_kernels(entries: list[dict]) -> float:
                     seen.add(key)
                     _step_twice(scene_from_dict(data))
                 continue
-            plain = {k: v for k, v in data.items() if k != "warm_from"}
-            if plain.get("start") == "warm":
-                plain["start"] = "lubrication"
-            case = case_from_dict(plain)
-            scene = build_scene(case_from_dict({**plain, "dp": max(case.dp, case.h_n / COARSE_HN)})).to_dict()
+            scene = build_scene(_coarse(data)).to_dict()
             fluid = {k: v for k, v in scene["fluid"].items() if k not in ("blocks", "profiles")}
             key = json.dumps([scene["numerics"], fluid, data.get("start") == "warm"], sort_keys=True)
             if key not in seen:

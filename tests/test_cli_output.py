@@ -131,3 +131,18 @@ def test_a_killed_scene_run_resumes_from_its_checkpoint_bit_for_bit(tmp_path):
     assert a.attrs["steps"] == b.attrs["steps"] and a.sizes == b.sizes
     for v in a.data_vars:
         np.testing.assert_array_equal(a[v].values, b[v].values, err_msg=v)
+
+
+@pytest.mark.slow
+def test_warm_compiles_from_a_list_of_cases_and_scenes(tmp_path, examples_dir):
+    """``solver warm`` takes a file holding a list of case and scene dicts (a campaign's
+    kernel_cases.yaml): it runs each case as a run would, at its coarse dp, a warm-started one
+    from the first run's file, and steps each scene."""
+    import yaml
+    cases = [{"dp": 0.004, "ch": 1.5, "shifting": "lind", "start": "warm", "warm_from": "absent.nc"},
+             yaml.safe_load((examples_dir / "couette.yaml").read_text())]
+    listed = tmp_path / "kernel_cases.yaml"
+    listed.write_text(yaml.safe_dump(cases))
+    p = run_cli("warm", str(listed), "--touch", str(tmp_path / "done"))
+    assert p.returncode == 0, p.stderr
+    assert "numba kernels compiled and cached" in p.stderr and (tmp_path / "done").exists()
