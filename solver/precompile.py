@@ -63,23 +63,24 @@ def _cold(data: dict) -> dict:
     return data
 
 
-def _coarse(data: dict, **keys):
-    """The case at its coarse dp (h_n / COARSE_HN, or its own where coarser), ``keys`` set."""
+def _coarse(data: dict):
+    """The case, cold, at its coarse dp (h_n / COARSE_HN, or its own where coarser), run for
+    RUN_TIME."""
     from .conveyor import case_from_dict
     data = _cold(data)
     case = case_from_dict(data)
-    return case_from_dict({**data, "dp": max(case.dp, case.h_n / COARSE_HN), **keys})
+    return case_from_dict({**data, "dp": max(case.dp, case.h_n / COARSE_HN),
+                           "steady": {**(data.get("steady") or {}), "max_time": RUN_TIME}})
 
 
-def _conveyor(data: dict, folder: Path) -> None:
-    from .conveyor import build_scene
+def _conveyor(coarse, warm: bool, scene, folder: Path) -> None:
+    """Run the coarse case (``_coarse``) and, for a warm-started case, once more from its file."""
     from .front import run_front
-    coarse = _coarse(data, steady={**(data.get("steady") or {}), "max_time": RUN_TIME})
     source = folder / "source.nc"
     run_front(coarse).to_netcdf(source)
-    if data.get("start") == "warm":
+    if warm:
         run_front(replace(coarse, start="warm", warm_from=str(source)))
-    _beyond_the_coarse_run(build_scene(coarse))
+    _beyond_the_coarse_run(scene)
 
 
 def _generic() -> list[dict]:
@@ -106,10 +107,13 @@ def compile_kernels(entries: list[dict]) -> float:
                     seen.add(key)
                     _step_twice(scene_from_dict(data))
                 continue
-            scene = build_scene(_coarse(data)).to_dict()
-            fluid = {k: v for k, v in scene["fluid"].items() if k not in ("blocks", "profiles")}
-            key = json.dumps([scene["numerics"], fluid, data.get("start") == "warm"], sort_keys=True)
+            coarse = _coarse(data)
+            warm = data.get("start") == "warm"
+            scene = build_scene(coarse)
+            d = scene.to_dict()
+            fluid = {k: v for k, v in d["fluid"].items() if k not in ("blocks", "profiles")}
+            key = json.dumps([d["numerics"], fluid, warm], sort_keys=True)
             if key not in seen:
                 seen.add(key)
-                _conveyor(data, Path(tmp))
+                _conveyor(coarse, warm, scene, Path(tmp))
     return time.perf_counter() - tic
